@@ -1,0 +1,39 @@
+# Two commands for a fresh machine (Python 3.11 is all it needs):
+#   make run    set up .venv, record a short session and print its summary
+#   make test   set up .venv and run the test suite
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
+
+.PHONY: setup run test bench lint format clean
+
+setup: $(STAMP)
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	# CPU build of torch first (a local file on these machines), so nothing pulls a CUDA build.
+	$(BIN)/python -m pip install --quiet torch==2.13.0
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	rm -f $(VENV)/.installed-* && touch $@
+
+run: setup
+	$(BIN)/python -m robohealth_mj.record session.duration_s=60
+
+test: setup
+	$(BIN)/python -m pytest
+
+bench: setup
+	$(BIN)/python -m robohealth_mj.bench sim
+
+lint: setup
+	$(BIN)/ruff check robohealth_mj tests
+	$(BIN)/ruff format --check robohealth_mj tests
+
+format: setup
+	$(BIN)/ruff format robohealth_mj tests
+	$(BIN)/ruff check --fix robohealth_mj tests
+
+clean:
+	rm -rf $(VENV) outputs .pytest_cache .ruff_cache

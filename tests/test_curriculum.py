@@ -1,0 +1,80 @@
+"""The trajectory curriculum (thesis §2.3.2)."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from hydra.utils import instantiate
+
+from robohealth_mj.sim.model import ArmIndex
+
+SPEED_LIMIT = 3.14  # rad/s, the UR5e joint speed limit (parameter file)
+
+
+def _curriculum(record_cfg, *overrides, seed=0):
+    cfg = record_cfg(*overrides)
+    return instantiate(cfg.curriculum, seed=seed, _convert_="all")
+
+
+def test_standard_curriculum_has_126_segments_in_three_families(record_cfg):
+    c = _curriculum(record_cfg)
+    families = [s.family for s in c.segments]
+    assert len(c) == 126
+    assert (
+        families.count("single_joint"),
+        families.count("joint_pair"),
+        families.count("whole_arm"),
+    ) == (54, 45, 27)
+    assert {s.waveform for s in c.segments if s.family == "whole_arm"} == {
+        "sine",
+        "triangle",
+        "compound",
+    }
+    pairs = {s.joints for s in c.segments if s.family == "joint_pair"}
+    assert len(pairs) == 15
+
+
+def test_speed_and_payload_lists_are_config(record_cfg):
+    c = _curriculum(record_cfg, "curriculum.payload_scales=[2.2]", "curriculum.speed_scales=[1.0]")
+    assert len(c) == 6 + 15 + 3
+    assert {s.payload_scale for s in c.segments} == {2.2}
+    assert c.payload_kg(0) == 2.2 * c.nominal_payload_kg
+
+
+def test_order_is_shuffled_per_seed_and_reshuffled_per_pass(record_cfg):
+    def order(seed, first_visit=0):
+        c = _curriculum(record_cfg, seed=seed)
+        return [c.scheduled(v).segment.index for v in range(first_visit, first_visit + 126)]
+
+    assert order(1) == order(1)
+    assert order(1) != order(2)
+    assert sorted(order(1)) == list(range(126))
+    assert order(1, 126) != order(1) and sorted(order(1, 126)) == list(range(126))
+
+
+def test_reference_is_smooth_across_segments_and_within_speed_limits(record_cfg):
+    c = _curriculum(record_cfg, seed=5)
+    t_all, q_all, qd_all = [], [], []
+    for visit in range(len(c)):
+        t = c.scheduled(visit).t_start + np.arange(0.0, c.segment_s, 0.002)
+        q, qd, _ = c.reference(visit, t)
+        t_all.append(t), q_all.append(q), qd_all.append(qd)
+    q, qd = np.concatenate(q_all), np.concatenate(qd_all)
+    assert np.abs(qd).max() <= SPEED_LIMIT
+    jumps = np.abs(np.diff(q, axis=0)).max()
+    assert jumps < SPEED_LIMIT * 0.002 * 1.01  # no step anywhere, boundaries included
+
+
+def test_reference_poses_stay_clear_of_the_floor_and_of_the_arm_itself(record_cfg, model):
+    """Every reference pose of a full pass, for several seeds, has no contact at all."""
+    data = mujoco.MjData(model)
+    index = ArmIndex.of(model)
+    for seed in (0, 1, 2):
+        c = _curriculum(record_cfg, seed=seed)
+        for visit in range(len(c)):
+            t = c.scheduled(visit).t_start + np.arange(0.0, c.segment_s, 0.1)
+            for q in c.position(visit, t):
+                index.set_link_pose(data, q)
+                mujoco.mj_kinematics(model, data)
+                mujoco.mj_collision(model, data)
+                assert data.ncon == 0, (seed, visit, q)

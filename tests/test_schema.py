@@ -1,0 +1,124 @@
+"""The GraphSample schema and the strict JSONL reader."""
+
+from __future__ import annotations
+
+import copy
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from robohealth_mj import schema
+from robohealth_mj.data.jsonl import format_line, node_features, read_samples
+from robohealth_mj.schema import FaultLabel, SchemaError, validate_sample
+
+
+def _sample_obj(index: int = 0) -> dict:
+    rng = np.random.default_rng(index)
+    x = node_features(*(rng.normal(size=6) for _ in range(4)), rng.normal(size=(6, 3)))
+    line = format_line(
+        "run-a",
+        index,
+        0.05 * (index + 1),
+        x,
+        FaultLabel(),
+        {"index": 3, "family": "single_joint", "speed_scale": 1.0, "payload_scale": 1.0},
+    )
+    return json.loads(line)
+
+
+def test_graph_has_the_canonical_nodes_and_bidirectional_edges():
+    assert schema.NODE_NAMES[:6] == schema.JOINT_NAMES
+    assert schema.NODE_NAMES[6:] == tuple(f"{j}_sensor" for j in schema.JOINT_NAMES)
+    assert len(schema.FEATURE_NAMES) == 9
+    edges = set(schema.EDGES)
+    assert len(edges) == 2 * 5 + 2 * 6
+    assert all((j, i) in edges for i, j in edges)
+    a = schema.adjacency()
+    np.testing.assert_array_equal(a, a.T)
+    assert a[2, 3] == 1 and a[2, 8] == 1 and a[2, 4] == 0 and a[8, 9] == 0
+    assert schema.edge_index().shape == (2, 22)
+
+
+def test_a_formatted_line_validates_and_round_trips():
+    obj = _sample_obj()
+    sample = validate_sample(obj)
+    assert sample.x.shape == (12, 9)
+    np.testing.assert_array_equal(sample.x[:6, 5:], 0.0)
+    np.testing.assert_allclose(sample.x[6:, 2:5], sample.x[:6, 2:5])
+    assert sample.fault.fault_class == "none" and not sample.fault.active
+
+
+def _set(path: str, value):
+    def edit(obj):
+        target = obj
+        *parents, last = path.split(".")
+        for key in parents:
+            target = target[key]
+        if value is _DELETE:
+            del target[last]
+        else:
+            target[last] = value(target[last]) if callable(value) else value
+
+    return edit
+
+
+_DELETE = object()
+
+
+def _nan_in_x(x):
+    x[8][6] = float("nan")
+    return x
+
+
+def _joint_with_vibration(x):
+    x[2][5] = 0.5
+    return x
+
+
+@pytest.mark.parametrize(
+    "edit, field",
+    [
+        (_set("schema_version", "0.9"), "schema_version"),
+        (_set("recording_run_id", _DELETE), "recording_run_id"),
+        (_set("x", _nan_in_x), "x[elbow_sensor].acc_x"),
+        (_set("nodes", lambda n: n[::-1]), "nodes"),
+        (_set("edge_index", lambda e: [e[0][:-2], e[1][:-2]]), "edge_index"),
+        (_set("x", _joint_with_vibration), "x.vib/acc"),
+        (_set("x", lambda x: x[:11]), "x"),
+        (_set("fault.class", "melted"), "fault.class"),
+        (_set("fault.severity", 1.5), "fault.severity"),
+        (_set("fault.active", True), "fault.active"),
+        (_set("segment.payload_scale", _DELETE), "segment.payload_scale"),
+        (_set("sample_index", "7"), "sample_index"),
+    ],
+)
+def test_each_schema_violation_names_its_field(edit, field):
+    obj = copy.deepcopy(_sample_obj())
+    edit(obj)
+    with pytest.raises(SchemaError, match=re.escape(f"f.jsonl:4: field '{field}'")):
+        validate_sample(obj, source="f.jsonl", line=4)
+
+
+def _write(path: Path, lines: list[str]) -> Path:
+    path.write_text("".join(lines))
+    return path
+
+
+def test_reader_reports_a_truncated_last_line(tmp_path):
+    lines = [json.dumps(_sample_obj(i)) + "\n" for i in range(3)]
+    path = _write(tmp_path / "g.jsonl", [*lines[:2], lines[2][:200]])
+    with pytest.raises(SchemaError, match=r"g.jsonl:3: field '<line>': truncated"):
+        list(read_samples(path))
+
+
+def test_reader_reports_invalid_json_and_non_increasing_indices(tmp_path):
+    good = [json.dumps(_sample_obj(i)) + "\n" for i in range(3)]
+    path = _write(tmp_path / "bad.jsonl", [good[0], "{not json\n", good[2]])
+    with pytest.raises(SchemaError, match=r"bad.jsonl:2: field '<json>'"):
+        list(read_samples(path))
+    path = _write(tmp_path / "order.jsonl", [good[1], good[0]])
+    with pytest.raises(SchemaError, match=r"order.jsonl:2: field 'sample_index'"):
+        list(read_samples(path))
