@@ -25,6 +25,7 @@ from tqdm import tqdm
 
 from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.data.jsonl import format_line, node_features
+from robohealth_mj.faults.injector import FaultInjector
 from robohealth_mj.schema import (
     EDGES,
     FEATURE_NAMES,
@@ -66,6 +67,8 @@ class SessionStats:
     visits: list[int] = field(default_factory=list)
     families: dict[str, int] = field(default_factory=dict)
     classes: dict[str, int] = field(default_factory=dict)
+    joints: dict[str, int] = field(default_factory=dict)
+    scenarios: set[tuple[str, str, float]] = field(default_factory=set)
 
     def add(self, chunk: TickChunk, segment: dict[str, Any], fault: FaultLabel) -> None:
         err = chunk.true_pos - chunk.reference
@@ -79,6 +82,9 @@ class SessionStats:
             self.visits.append(chunk.visit)
         self.families[segment["family"]] = self.families.get(segment["family"], 0) + n
         self.classes[fault.fault_class] = self.classes.get(fault.fault_class, 0) + n
+        if fault.active:
+            self.joints[fault.joint] = self.joints.get(fault.joint, 0) + n
+            self.scenarios.add((fault.fault_class, fault.joint, fault.severity))
 
     def as_dict(self) -> dict[str, Any]:
         rms = np.sqrt(self.sq_error / max(self.samples, 1))
@@ -95,6 +101,8 @@ class SessionStats:
             "segments_visited": len(self.visits),
             "samples_per_family": dict(sorted(self.families.items())),
             "samples_per_class": dict(sorted(self.classes.items())),
+            "faulted_samples_per_joint": dict(sorted(self.joints.items())),
+            "scenarios_covered": len(self.scenarios),
         }
 
 
@@ -121,6 +129,10 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
     curriculum = instantiate(cfg.curriculum, seed=cfg.seed, _convert_="all")
     controller = instantiate(cfg.control, model=model)
     sensors = instantiate(cfg.sensors, physics_rate_hz=1.0 / model.opt.timestep, _convert_="all")
+    tick_s = round(1.0 / (cfg.session.tick_hz * model.opt.timestep)) * model.opt.timestep
+    schedule = instantiate(cfg.faults.schedule, tick_s=tick_s, seed=cfg.seed, _convert_="all")
+    params = instantiate(cfg.fault_params, seed=cfg.seed, _convert_="all")
+    faults = FaultInjector(schedule, params, cfg.faults.fault_model, model, tick_s, cfg.seed)
     return ArmSimulator(
         model,
         curriculum,
@@ -129,6 +141,7 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
         seed=cfg.seed,
         tick_hz=cfg.session.tick_hz,
         chunk_s=cfg.session.chunk_s,
+        faults=faults,
     )
 
 
@@ -143,11 +156,8 @@ def record_session(cfg: DictConfig, out_dir: Path | str) -> RecordingResult:
     """Record one session into ``out_dir`` (graphs.jsonl + manifest.json)."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    duration = float(cfg.session.duration_s)
-    if duration <= 0:
-        raise ValueError(f"session.duration_s must be > 0, got {duration}")
     sim = build_simulator(cfg)
-    n_ticks = round(duration / sim.tick_s)
+    n_ticks = _session_ticks(cfg, sim)
     run_id = cfg.session.run_id or default_run_id(cfg)
     manifest: dict[str, Any] = {
         "schema_version": SCHEMA_VERSION,
@@ -163,6 +173,7 @@ def record_session(cfg: DictConfig, out_dir: Path | str) -> RecordingResult:
         },
         "rates": {"physics_hz": 1.0 / sim.dt, "tick_hz": 1.0 / sim.tick_s},
         "expected_samples": n_ticks,
+        "faults": sim.faults.describe(),
         "config": session_config(cfg),
     }
     atomic_write_json(out_dir / MANIFEST_FILE, manifest)
@@ -210,6 +221,22 @@ def record_session(cfg: DictConfig, out_dir: Path | str) -> RecordingResult:
     return RecordingResult(out_dir, manifest, wall)
 
 
+def _session_ticks(cfg: DictConfig, sim: ArmSimulator) -> int:
+    """Session length in ticks: whole fault-schedule passes if asked, else the duration."""
+    passes = cfg.session.get("passes")
+    if passes is not None:
+        pass_ticks = getattr(sim.faults.schedule, "pass_ticks", None)
+        if pass_ticks is None:
+            raise ValueError("session.passes needs the fault scheduler (faults=schedule)")
+        if int(passes) < 1:
+            raise ValueError(f"session.passes must be >= 1, got {passes}")
+        return int(passes) * pass_ticks
+    duration = float(cfg.session.duration_s)
+    if duration <= 0:
+        raise ValueError(f"session.duration_s must be > 0, got {duration}")
+    return round(duration / sim.tick_s)
+
+
 def _chunk_lines(sim: ArmSimulator, chunk: TickChunk, run_id: str, stats: SessionStats) -> str:
     seg = sim.curriculum.scheduled(chunk.visit).segment
     segment = {
@@ -220,7 +247,7 @@ def _chunk_lines(sim: ArmSimulator, chunk: TickChunk, run_id: str, stats: Sessio
         "speed_scale": seg.speed_scale,
         "payload_scale": seg.payload_scale,
     }
-    fault = FaultLabel()
+    fault = chunk.fault
     stats.add(chunk, segment, fault)
     first = sim.tick - len(chunk.t)
     lines = []
@@ -243,6 +270,8 @@ def summary_text(result: RecordingResult) -> str:
         f"{m['rates']['tick_hz']:.0f} Hz, {sim_s / max(result.wall_s, 1e-9):.0f}x real time)",
         f"segments  {s['segments_visited']} visited; samples per family {s['samples_per_family']}",
         f"classes   {s['samples_per_class']}",
+        f"faults    {m['faults']['fault_model']} model; {s['scenarios_covered']} joint x fault x "
+        f"severity scenarios covered",
         f"tracking  worst joint RMS {worst:.5f} rad; per joint {s['tracking_rms_rad']}",
         f"torque    saturated physics steps {s['torque_saturated_steps']}",
         f"contacts  max {s['max_contacts']}; MuJoCo warnings {m['mujoco_warnings'] or 'none'}",

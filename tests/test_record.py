@@ -44,7 +44,10 @@ def test_a_120_s_session_has_2400_valid_samples_and_a_complete_manifest(record_c
     assert on_disk["config"]["seed"] == 11
     assert on_disk["code_version"]
     assert max(on_disk["stats"]["tracking_rms_rad"].values()) < 0.01
-    assert {s.fault.fault_class for s in samples} == {"none"}
+    # the default fault schedule: 12 s faulted, 8 s healthy, labels on every sample
+    active = [s.fault.active for s in samples]
+    assert active[:240] == [True] * 240 and active[240:400] == [False] * 160
+    assert len({(s.fault.fault_class, s.fault.joint, s.fault.severity) for s in samples}) == 7
     assert {s.segment["family"] for s in samples} <= {"single_joint", "joint_pair", "whole_arm"}
 
 

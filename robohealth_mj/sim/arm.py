@@ -14,6 +14,9 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
+from robohealth_mj.faults.injector import FaultInjector, healthy_injector
+from robohealth_mj.faults.readings import TickReadings
+from robohealth_mj.schema import FaultLabel
 from robohealth_mj.sim.control import TrackingController
 from robohealth_mj.sim.curriculum import Curriculum
 from robohealth_mj.sim.model import ArmIndex
@@ -35,6 +38,7 @@ class TickChunk:
     reference: np.ndarray  # [n, 6]
     saturated_steps: np.ndarray  # [6] physics steps at the torque limit, per joint
     contacts: int  # contacts present at the end of the chunk
+    fault: FaultLabel  # the ground truth, constant over the chunk
 
 
 class ArmSimulator:
@@ -49,6 +53,7 @@ class ArmSimulator:
         seed: int,
         tick_hz: float = 20.0,
         chunk_s: float = 1.0,
+        faults: FaultInjector | None = None,
     ) -> None:
         self.model, self.curriculum = model, curriculum
         self.controller, self.sensors = controller, sensors
@@ -58,10 +63,13 @@ class ArmSimulator:
         self.tick_s = self.tick_steps * self.dt
         self.ticks_per_segment = _whole(curriculum.segment_s / self.tick_s, "ticks per segment")
         self.chunk_ticks = max(1, round(chunk_s / self.tick_s))
+        self.payload_ramp_ticks = round(curriculum.payload_ramp_s / self.tick_s)
         self.rng = np.random.default_rng([int(seed), 2])
         self.data = mujoco.MjData(model)
         self.tick = 0  # ticks completed
         self.nstate = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        self.faults = faults or healthy_injector(model, self.tick_s)
+        self._interval = None
         self._start_at_rest()
 
     def _start_at_rest(self) -> None:
@@ -74,8 +82,12 @@ class ArmSimulator:
         d.qpos[idx.deflection_qpos] = twist
         mujoco.mj_forward(self.model, d)
 
-    def _apply_payload(self, visit: int) -> None:
-        payload = self.curriculum.payload_kg(visit)
+    def _apply_payload(self, visit: int, fraction: float = 1.0) -> None:
+        """Set the payload part-way (``fraction``) from the previous visit's to this visit's."""
+        new = self.curriculum.payload_kg(visit)
+        old = self.curriculum.payload_kg(visit - 1) if visit > 0 else new
+        u = min(max(fraction, 0.0), 1.0)
+        payload = old + (new - old) * u * u * (3.0 - 2.0 * u)
         self.model.body_mass[self.index.payload_body] = payload
         self.controller.set_payload(payload)
 
@@ -87,10 +99,23 @@ class ArmSimulator:
         """Advance ``n_ticks`` ticks, yielding chunks as they are simulated."""
         end = self.tick + n_ticks
         while self.tick < end:
-            visit = self.tick // self.ticks_per_segment
-            segment_end = (visit + 1) * self.ticks_per_segment
-            n = min(self.chunk_ticks, end - self.tick, segment_end - self.tick)
-            if self.tick % self.ticks_per_segment == 0:
+            visit, tick_in_visit = divmod(self.tick, self.ticks_per_segment)
+            interval = self.faults.interval_at(self.tick)
+            if interval != self._interval:
+                self.faults.enter(self.model, interval)
+                self._interval = interval
+            n = min(
+                self.chunk_ticks,
+                end - self.tick,
+                self.ticks_per_segment - tick_in_visit,
+                interval.end_tick - self.tick,
+            )
+            if tick_in_visit < self.payload_ramp_ticks:
+                # The payload is taken on gradually while the arm is at rest between segments;
+                # a step in load would ring the drives at every segment boundary.
+                n = 1
+                self._apply_payload(visit, (tick_in_visit + 1) / self.payload_ramp_ticks)
+            elif tick_in_visit == 0:
                 self._apply_payload(visit)
             yield self._simulate(visit, n)
 
@@ -98,32 +123,38 @@ class ArmSimulator:
         steps = n_ticks * self.tick_steps
         first = self.tick * self.tick_steps
         step_times = (first + np.arange(steps)) * self.dt
-        ctrl = self._controls(visit, step_times)
+        ctrl, ref_velocity = self._controls(visit, step_times)
+        forces = self.faults.torques(self._interval, step_times, ref_velocity, self.model.nv)
         state0 = np.empty(self.nstate)
         mujoco.mj_getState(self.model, self.data, state0, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         state, sensordata = rollout.rollout(
             self.model,
             self.data,
             state0[None],
-            ctrl[None],
+            np.hstack([ctrl, forces])[None],
+            control_spec=_CONTROL_SPEC,
             initial_warmstart=self.data.qacc_warmstart[None],
         )
         state, sensordata = state[0], sensordata[0]
         self.tick += n_ticks
-        return self._readings(visit, state, sensordata, n_ticks)
+        return self._readings(visit, state, sensordata)
 
-    def _controls(self, visit: int, step_times: np.ndarray) -> np.ndarray:
-        """Commands for every physics step, from inverse dynamics at knots on a global grid."""
+    def _controls(self, visit: int, step_times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Commands and reference velocities for every physics step (inverse dynamics at knots
+        on a global grid, interpolated)."""
         knot_dt = self.controller.knot_dt
         k0 = int(np.floor(step_times[0] / knot_dt + 1e-9))
         k1 = int(np.ceil(step_times[-1] / knot_dt - 1e-9))
         knots = np.arange(k0, max(k1, k0 + 1) + 1) * knot_dt
-        ctrl_knots, _ = self.controller.commands(*self.curriculum.reference(visit, knots))
-        return np.stack([np.interp(step_times, knots, ctrl_knots[:, j]) for j in range(6)], axis=1)
+        q, qd, qdd = self.curriculum.reference(visit, knots)
+        ctrl_knots, _ = self.controller.commands(q, qd, qdd)
 
-    def _readings(
-        self, visit: int, state: np.ndarray, sensordata: np.ndarray, n_ticks: int
-    ) -> TickChunk:
+        def per_step(values: np.ndarray) -> np.ndarray:
+            return np.stack([np.interp(step_times, knots, values[:, j]) for j in range(6)], axis=1)
+
+        return per_step(ctrl_knots), per_step(qd)
+
+    def _readings(self, visit: int, state: np.ndarray, sensordata: np.ndarray) -> TickChunk:
         idx = self.index
         at_tick = slice(self.tick_steps - 1, None, self.tick_steps)
         qpos = state[at_tick, 1 : 1 + self.model.nq]
@@ -132,26 +163,28 @@ class ArmSimulator:
         true_pos = qpos[:, idx.motor_qpos] + qpos[:, idx.deflection_qpos]
         vel = qvel[:, idx.motor_dof] + qvel[:, idx.deflection_dof]
         effort_all = sensordata[:, idx.effort_sensor]
-        effort = effort_all[at_tick]
         acc_mean, vib = self.sensors.process(sensordata[:, idx.acc_sensor], self.tick_steps)
-        pos, vel, effort, vib, acc = self.sensors.add_noise(
-            self.rng, true_pos, vel, effort, vib, acc_mean
-        )
-        saturated = (np.abs(effort_all) >= 0.999 * idx.torque_limit).sum(axis=0)
-        reference = self.curriculum.position(visit, t)
+        noisy = self.sensors.add_noise(self.rng, true_pos, vel, effort_all[at_tick], vib, acc_mean)
+        readings = TickReadings(*noisy)
+        self.faults.alter_readings(self._interval, readings)
+        scenario = self._interval.scenario
         return TickChunk(
-            t,
-            visit,
-            pos,
-            vel,
-            effort,
-            vib,
-            acc,
-            true_pos,
-            reference,
-            saturated,
-            int(self.data.ncon),
+            t=t,
+            visit=visit,
+            pos=readings.pos,
+            vel=readings.vel,
+            effort=readings.effort,
+            vib=readings.vib,
+            acc=readings.acc,
+            true_pos=true_pos,
+            reference=self.curriculum.position(visit, t),
+            saturated_steps=(np.abs(effort_all) >= 0.999 * idx.torque_limit).sum(axis=0),
+            contacts=int(self.data.ncon),
+            fault=scenario.label if scenario is not None else FaultLabel(),
         )
+
+
+_CONTROL_SPEC = int(mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED)
 
 
 def _whole(value: float, what: str) -> int:

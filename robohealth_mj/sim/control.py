@@ -74,16 +74,22 @@ class TrackingController:
         """Actuator commands and feed-forward torques for reference samples ``[n, 6]``."""
         motor, spring = self.inverse_dynamics(q, qd, qdd)
         tau_ff = motor + self.coulomb * np.tanh(qd / self.coulomb_velocity_scale)
-        twist = spring / self.stiffness + self.backlash * np.tanh(
-            spring / self.backlash_torque_scale
-        )
-        ctrl = (q - twist) + (self.kv * qd + tau_ff) / self.kp
+        ctrl = (q - self.twist(spring)) + (self.kv * qd + tau_ff) / self.kp
         return ctrl, tau_ff
+
+    def twist(self, spring: np.ndarray) -> np.ndarray:
+        """Drive deflection (link minus motor angle) that produces the required drive torque.
+
+        The drive's passive force on the deflection hinge is ``-k (delta -/+ b)`` outside the
+        dead band, so carrying a required generalised force ``tau`` takes
+        ``delta = -(tau/k + b sgn tau)``.
+        """
+        return -(
+            spring / self.stiffness + self.backlash * np.tanh(spring / self.backlash_torque_scale)
+        )
 
     def static_twist(self, q: np.ndarray) -> np.ndarray:
         """Drive deflection ``[6]`` that carries gravity at rest pose ``q`` (for a quiet start)."""
         zeros = np.zeros((1, q.size))
         _, spring = self.inverse_dynamics(q[None], zeros, zeros)
-        return (
-            spring / self.stiffness + self.backlash * np.tanh(spring / self.backlash_torque_scale)
-        )[0]
+        return self.twist(spring)[0]

@@ -86,6 +86,8 @@ class Curriculum:
         whole_arm_amplitude_factor: float,
         center_jitter_rad: Sequence[float],
         home: Sequence[float],
+        payload_ramp_s: float = 1.0,
+        families: Sequence[str] = FAMILIES,
         seed: int = 0,
     ) -> None:
         if not speed_scales or not payload_scales:
@@ -110,6 +112,13 @@ class Curriculum:
         self.whole_factor = float(whole_arm_amplitude_factor)
         self.jitter = np.asarray(center_jitter_rad, dtype=float)
         self.home = np.asarray(home, dtype=float)
+        if not 0.0 <= payload_ramp_s <= blend_s:
+            raise ValueError(f"payload_ramp_s ({payload_ramp_s}) must be in [0, blend_s]")
+        self.payload_ramp_s = float(payload_ramp_s)
+        unknown = sorted(set(families) - set(FAMILIES))
+        if unknown or not families:
+            raise ValueError(f"curriculum.families must be a non-empty subset of {FAMILIES}")
+        self.families = tuple(families)
         self.seed = int(seed)
         self.segments = self._enumerate()
         self._cache: dict[int, ScheduledSegment] = {}
@@ -125,7 +134,7 @@ class Curriculum:
             out.append(Segment(len(out), "joint_pair", "sine", pair, speed, payload))
         for wave, speed, payload in itertools.product(WAVEFORMS, speeds, payloads):
             out.append(Segment(len(out), "whole_arm", wave, tuple(range(N_JOINTS)), speed, payload))
-        return out
+        return [s for s in out if s.family in self.families]
 
     def __len__(self) -> int:
         return len(self.segments)

@@ -45,10 +45,10 @@ class SensorPackage:
             filter_order, [low, high], btype="bandpass", fs=physics_rate_hz, output="sos"
         )
         self.noise = noise if isinstance(noise, NoiseFloor) else NoiseFloor(**(noise or {}))
-        self._zi = np.zeros((self.sos.shape[0], 2, N_JOINTS * 3))
+        self._zi: np.ndarray | None = None
 
     def reset(self) -> None:
-        self._zi[:] = 0.0
+        self._zi = None
 
     def process(self, acc: np.ndarray, tick_steps: int) -> tuple[np.ndarray, np.ndarray]:
         """High-rate accelerations ``[steps, 6, 3]`` -> tick means ``[ticks, 6, 3]`` and vibration
@@ -57,6 +57,8 @@ class SensorPackage:
         if steps % tick_steps:
             raise ValueError(f"{steps} steps is not a whole number of {tick_steps}-step ticks")
         flat = acc.reshape(steps, N_JOINTS * 3)
+        if self._zi is None:  # start in steady state on the first reading: no start-up ring
+            self._zi = signal.sosfilt_zi(self.sos)[:, :, None] * flat[0][None, None, :]
         band, self._zi = signal.sosfilt(self.sos, flat, axis=0, zi=self._zi)
         ticks = steps // tick_steps
         magnitude_sq = (band.reshape(ticks, tick_steps, N_JOINTS, 3) ** 2).sum(axis=-1)
