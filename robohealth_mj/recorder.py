@@ -132,7 +132,9 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
     tick_s = round(1.0 / (cfg.session.tick_hz * model.opt.timestep)) * model.opt.timestep
     schedule = instantiate(cfg.faults.schedule, tick_s=tick_s, seed=cfg.seed, _convert_="all")
     params = instantiate(cfg.fault_params, seed=cfg.seed, _convert_="all")
-    faults = FaultInjector(schedule, params, cfg.faults.fault_model, model, tick_s, cfg.seed)
+    faults = FaultInjector(
+        schedule, params, cfg.faults.fault_model, model, tick_s, cfg.seed, ramp_s=cfg.faults.ramp_s
+    )
     return ArmSimulator(
         model,
         curriculum,

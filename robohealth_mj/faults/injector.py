@@ -29,11 +29,13 @@ class FaultInjector:
         model: mujoco.MjModel,
         tick_s: float,
         seed: int,
+        ramp_s: float = 0.5,
     ) -> None:
         if fault_model not in FAULT_MODELS:
             raise ValueError(f"fault_model must be one of {FAULT_MODELS}, got {fault_model!r}")
         self.schedule, self.parameters, self.fault_model = schedule, parameters, fault_model
         self.physics_on = fault_model != "analytic"
+        self.ramp_ticks = round(ramp_s / tick_s)
         self.drives = DriveFaults(model, parameters.physics)
         self.readings = ReadingFaults(
             parameters.physics,
@@ -54,9 +56,26 @@ class FaultInjector:
         sc = interval.scenario
         return self.physics_on and sc is not None and sc.fault_class in MECHANICAL
 
-    def enter(self, model: mujoco.MjModel, interval: Interval) -> None:
-        """Set the simulated drives for an interval (restoring the nominal ones first)."""
-        self.drives.apply(model, interval.scenario if self._mechanical(interval) else None)
+    def prepare(self, model: mujoco.MjModel, tick: int) -> tuple[Interval, int]:
+        """Set the simulated drives for ``tick``; return its interval and for how many ticks the
+        drives stay as set.
+
+        A mechanical fault develops over its first ``ramp_ticks`` and clears over its last, so
+        the drives are exactly nominal when the fault interval ends and no parameter step rings
+        the arm (a real drive degrades, it does not switch).
+        """
+        interval = self.schedule.interval_at(tick)
+        if not self._mechanical(interval):
+            self.drives.apply(model, None)
+            return interval, interval.end_tick - tick
+        into, left = tick - interval.start_tick, interval.end_tick - tick - 1
+        ramp = self.ramp_ticks
+        if ramp and (into < ramp or left < ramp):
+            level = _smoothstep(min((into + 1) / ramp, left / ramp, 1.0))
+            self.drives.apply(model, interval.scenario, level)
+            return interval, 1
+        self.drives.apply(model, interval.scenario)
+        return interval, interval.end_tick - ramp - tick
 
     def torques(
         self, interval: Interval, step_times: np.ndarray, ref_velocity: np.ndarray, nv: int
@@ -73,6 +92,11 @@ class FaultInjector:
             "schedule": self.schedule.describe(),
             "parameters": self.parameters.as_dict(),
         }
+
+
+def _smoothstep(u: float) -> float:
+    u = min(max(u, 0.0), 1.0)
+    return u * u * (3.0 - 2.0 * u)
 
 
 def healthy_injector(model: mujoco.MjModel, tick_s: float) -> FaultInjector:

@@ -35,12 +35,15 @@ class DriveFaults:
         for name, value in self.nominal.items():
             getattr(model, name)[:] = value
 
-    def apply(self, model: mujoco.MjModel, scenario: Scenario | None) -> None:
-        """Restore the nominal drives, then degrade the target drive for ``scenario``."""
+    def apply(self, model: mujoco.MjModel, scenario: Scenario | None, level: float = 1.0) -> None:
+        """Restore the nominal drives, then degrade the target drive for ``scenario``.
+
+        ``level`` in [0, 1] scales the severity while a fault develops or clears.
+        """
         self.restore(model)
-        if scenario is None:
+        if scenario is None or level <= 0.0:
             return
-        s, j = scenario.severity, scenario.joint
+        s, j = scenario.severity * min(level, 1.0), scenario.joint
         dof, tendon = self.index.motor_dof[j], self.index.tendon[j]
         p = self.params.get(scenario.fault_class, {})
         if scenario.fault_class == "backlash":

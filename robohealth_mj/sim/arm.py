@@ -100,15 +100,12 @@ class ArmSimulator:
         end = self.tick + n_ticks
         while self.tick < end:
             visit, tick_in_visit = divmod(self.tick, self.ticks_per_segment)
-            interval = self.faults.interval_at(self.tick)
-            if interval != self._interval:
-                self.faults.enter(self.model, interval)
-                self._interval = interval
+            self._interval, steady = self.faults.prepare(self.model, self.tick)
             n = min(
                 self.chunk_ticks,
                 end - self.tick,
                 self.ticks_per_segment - tick_in_visit,
-                interval.end_tick - self.tick,
+                steady,
             )
             if tick_in_visit < self.payload_ramp_ticks:
                 # The payload is taken on gradually while the arm is at rest between segments;
