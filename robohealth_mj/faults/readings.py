@@ -65,7 +65,7 @@ class ReadingFaults:
             self._interval = None
             return
         if interval_start != self._interval:
-            self._start(scenario, interval_start, rng)
+            self._start(interval_start, rng)
         mode = scenario.fault_class
         if mode == "sensor_drift":
             self._sensor_drift(scenario, r, rng)
@@ -74,7 +74,7 @@ class ReadingFaults:
         elif self.analytic_layer:
             getattr(self, f"_signature_{mode}")(scenario, r, rng)
 
-    def _start(self, scenario: Scenario, interval_start: int, rng: np.random.Generator) -> None:
+    def _start(self, interval_start: int, rng: np.random.Generator) -> None:
         self._interval = interval_start
         self._drift[:] = 0.0
         self._drift_sign = rng.choice([-1.0, 1.0], size=4)
