@@ -21,52 +21,39 @@ from robohealth_mj.schema import JOINT_NAMES
 SECONDS = 8.0
 
 
-def _run(record_cfg, *overrides: str):
-    sim = build_simulator(record_cfg("seed=3", *overrides))
+def _simulate(*overrides: str):
+    """Joint state ``[T, 6, 3]``, sensor readings ``[T, 6, 4]`` and labels of a short run."""
+    cfg = compose_config("record", ["seed=3", "session.progress=false", *overrides])
+    sim = build_simulator(cfg)
     chunks = list(sim.run(round(SECONDS / sim.tick_s)))
-    state = np.stack(
-        [np.concatenate([getattr(c, k) for c in chunks]) for k in ("pos", "vel", "effort")], axis=-1
-    )  # [T, 6, 3]
-    sensor = np.concatenate(
-        [
-            np.concatenate([c.vib for c in chunks])[:, :, None],
-            np.concatenate([c.acc for c in chunks]),
-        ],
-        axis=-1,
-    )  # [T, 6, 4]
-    labels = [c.fault for c in chunks]
-    return state, sensor, labels
+
+    def cat(name: str) -> np.ndarray:
+        return np.concatenate([getattr(c, name) for c in chunks])
+
+    state = np.stack([cat("pos"), cat("vel"), cat("effort")], axis=-1)
+    sensor = np.concatenate([cat("vib")[:, :, None], cat("acc")], axis=-1)
+    return state, sensor, [c.fault for c in chunks]
+
+
+def _fixed(fault_class: str, joint: str, *extra: str) -> list[str]:
+    return [
+        "faults=fixed",
+        f"faults.schedule.fault_class={fault_class}",
+        f"faults.schedule.joint={joint}",
+        *extra,
+    ]
 
 
 @pytest.fixture(scope="module")
 def healthy():
-    sim = build_simulator(
-        compose_config("record", ["seed=3", "session.progress=false", "faults=none"])
-    )
-    chunks = list(sim.run(round(SECONDS / sim.tick_s)))
-    state = np.stack(
-        [np.concatenate([getattr(c, k) for c in chunks]) for k in ("pos", "vel", "effort")], axis=-1
-    )
-    sensor = np.concatenate(
-        [
-            np.concatenate([c.vib for c in chunks])[:, :, None],
-            np.concatenate([c.acc for c in chunks]),
-        ],
-        axis=-1,
-    )
+    state, sensor, _ = _simulate("faults=none")
     return state, sensor
 
 
 @pytest.mark.parametrize("fault_class", MODES)
 def test_each_fault_changes_its_target_joint_beyond_the_noise(record_cfg, healthy, fault_class):
     joint = JOINT_NAMES.index("elbow")
-    state, sensor, labels = _run(
-        record_cfg,
-        "faults=fixed",
-        f"faults.schedule.fault_class={fault_class}",
-        "faults.schedule.joint=elbow",
-        "faults.schedule.severity=0.9",
-    )
+    state, sensor, labels = _simulate(*_fixed(fault_class, "elbow", "faults.schedule.severity=0.9"))
     assert all(
         lab.active and lab.fault_class == fault_class and lab.joint == "elbow" for lab in labels
     )
@@ -103,39 +90,21 @@ def test_physics_faults_propagate_and_fall_with_hop_distance(fault_class):
 def test_physics_friction_raises_the_effort_of_the_target_drive(record_cfg):
     """In physics mode friction acts through the dynamics: the drive works harder."""
     moving = ["curriculum.families=[whole_arm]", "curriculum.speed_scales=[1.0]"]
-    h_state, _, _ = _run(record_cfg, "faults=none", *moving)
-    state, _, _ = _run(
-        record_cfg,
-        "faults=fixed",
-        "faults.fault_model=physics",
-        "faults.schedule.fault_class=friction",
-        "faults.schedule.joint=elbow",
-        *moving,
-    )
+    h_state, _, _ = _simulate("faults=none", *moving)
+    state, _, _ = _simulate(*_fixed("friction", "elbow", "faults.fault_model=physics", *moving))
     j = JOINT_NAMES.index("elbow")
     assert np.abs(state[:, j, 2]).mean() > np.abs(h_state[:, j, 2]).mean() + 2.0
 
 
 def test_analytic_mode_leaves_the_physics_healthy(record_cfg, healthy):
-    state, sensor, _ = _run(
-        record_cfg,
-        "faults=fixed",
-        "faults.fault_model=analytic",
-        "faults.schedule.fault_class=jam",
-        "faults.schedule.joint=elbow",
-    )
+    state, sensor, _ = _simulate(*_fixed("jam", "elbow", "faults.fault_model=analytic"))
     h_state, h_sensor = healthy
     np.testing.assert_array_equal(state, h_state)  # same dynamics, same noise
     assert not np.array_equal(sensor, h_sensor)  # the painted signature
 
 
 def test_sensor_drift_changes_only_its_own_sensor(record_cfg, healthy):
-    state, sensor, _ = _run(
-        record_cfg,
-        "faults=fixed",
-        "faults.schedule.fault_class=sensor_drift",
-        "faults.schedule.joint=wrist_1",
-    )
+    state, sensor, _ = _simulate(*_fixed("sensor_drift", "wrist_1"))
     h_state, h_sensor = healthy
     j = JOINT_NAMES.index("wrist_1")
     others = [k for k in range(6) if k != j]
@@ -180,8 +149,14 @@ def test_mechanical_faults_are_undone_exactly(model):
 
 
 def test_a_fixed_fault_ends_and_the_drives_return_to_nominal(record_cfg):
-    sim = build_simulator(record_cfg("faults=fixed", "faults.schedule.fault_class=struct_weaken",
-                                     "faults.schedule.onset_s=1.0", "faults.schedule.end_s=3.0"))
+    sim = build_simulator(
+        record_cfg(
+            "faults=fixed",
+            "faults.schedule.fault_class=struct_weaken",
+            "faults.schedule.onset_s=1.0",
+            "faults.schedule.end_s=3.0",
+        )
+    )
     nominal = sim.model.tendon_stiffness.copy()
     assert not any(c.fault.active for c in sim.run(20))  # 0-1 s healthy
     assert all(c.fault.active for c in sim.run(20))  # 1-2 s: developed by now

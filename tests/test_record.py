@@ -70,8 +70,12 @@ def _cli(*args: str, **kwargs) -> subprocess.Popen:
 
 
 def test_an_interrupted_recording_is_readable_and_marked_incomplete(tmp_path):
-    proc = _cli("session.duration_s=3600", f"session.out_dir={tmp_path}",
-                "session.progress=false", f"hydra.run.dir={tmp_path / 'hydra'}")
+    proc = _cli(
+        "session.duration_s=3600",
+        f"session.out_dir={tmp_path}",
+        "session.progress=false",
+        f"hydra.run.dir={tmp_path / 'hydra'}",
+    )
     graphs = tmp_path / GRAPHS_FILE
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:

@@ -9,6 +9,7 @@ import numpy as np
 
 from robohealth_mj.data.jsonl import read_samples
 from robohealth_mj.recorder import GRAPHS_FILE, MANIFEST_FILE, record_session
+from robohealth_mj.schema import JOINT_NAMES
 
 
 def test_every_fault_at_full_severity_runs_clean_at_top_speed_and_payload(record_cfg, tmp_path):
@@ -25,14 +26,7 @@ def test_every_fault_at_full_severity_runs_clean_at_top_speed_and_payload(record
     assert manifest["mujoco_warnings"] == {}
     stats = manifest["stats"]
     assert stats["scenarios_covered"] == 36
-    assert set(stats["torque_saturated_steps"]) == {
-        "shoulder_pan",
-        "shoulder_lift",
-        "elbow",
-        "wrist_1",
-        "wrist_2",
-        "wrist_3",
-    }
+    assert set(stats["torque_saturated_steps"]) == set(JOINT_NAMES)
     assert stats["max_contacts"] == 0
     samples = list(read_samples(tmp_path / GRAPHS_FILE))  # raises on any NaN or Inf
     assert len(samples) == manifest["sample_count"] == 36 * 400
