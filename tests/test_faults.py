@@ -51,7 +51,7 @@ def healthy():
 
 
 @pytest.mark.parametrize("fault_class", MODES)
-def test_each_fault_changes_its_target_joint_beyond_the_noise(record_cfg, healthy, fault_class):
+def test_each_fault_changes_its_target_joint_beyond_the_noise(healthy, fault_class):
     joint = JOINT_NAMES.index("elbow")
     state, sensor, labels = _simulate(*_fixed(fault_class, "elbow", "faults.schedule.severity=0.9"))
     assert all(
@@ -87,7 +87,7 @@ def test_physics_faults_propagate_and_fall_with_hop_distance(fault_class):
     assert hops[0] > hops[1] > hops[2]
 
 
-def test_physics_friction_raises_the_effort_of_the_target_drive(record_cfg):
+def test_physics_friction_raises_the_effort_of_the_target_drive():
     """In physics mode friction acts through the dynamics: the drive works harder."""
     moving = ["curriculum.families=[whole_arm]", "curriculum.speed_scales=[1.0]"]
     h_state, _, _ = _simulate("faults=none", *moving)
@@ -96,14 +96,14 @@ def test_physics_friction_raises_the_effort_of_the_target_drive(record_cfg):
     assert np.abs(state[:, j, 2]).mean() > np.abs(h_state[:, j, 2]).mean() + 2.0
 
 
-def test_analytic_mode_leaves_the_physics_healthy(record_cfg, healthy):
+def test_analytic_mode_leaves_the_physics_healthy(healthy):
     state, sensor, _ = _simulate(*_fixed("jam", "elbow", "faults.fault_model=analytic"))
     h_state, h_sensor = healthy
     np.testing.assert_array_equal(state, h_state)  # same dynamics, same noise
     assert not np.array_equal(sensor, h_sensor)  # the painted signature
 
 
-def test_sensor_drift_changes_only_its_own_sensor(record_cfg, healthy):
+def test_sensor_drift_changes_only_its_own_sensor(healthy):
     state, sensor, _ = _simulate(*_fixed("sensor_drift", "wrist_1"))
     h_state, h_sensor = healthy
     j = JOINT_NAMES.index("wrist_1")
