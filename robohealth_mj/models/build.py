@@ -1,0 +1,33 @@
+"""Instantiating a model variant from its config and the graph it runs on."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+from hydra.utils import instantiate
+from omegaconf import DictConfig
+from torch import nn
+
+
+def build_model(
+    model_cfg: DictConfig | dict,
+    adjacency: np.ndarray | torch.Tensor,
+    num_joints: int,
+    in_features: int,
+    window: int,
+    **overrides,
+) -> nn.Module:
+    """``conf/model/<name>.yaml`` + the graph (``[N, N]`` adjacency, J joints first) -> module."""
+    adjacency = torch.as_tensor(np.asarray(adjacency), dtype=torch.float32)
+    if adjacency.ndim != 2 or adjacency.shape[0] != adjacency.shape[1]:
+        raise ValueError(f"adjacency must be square [N, N], got {tuple(adjacency.shape)}")
+    if not 0 < num_joints < adjacency.shape[0]:
+        raise ValueError(f"num_joints={num_joints} must leave at least one sensor node")
+    return instantiate(
+        model_cfg,
+        adjacency=adjacency,
+        num_joints=num_joints,
+        in_features=in_features,
+        window=window,
+        **overrides,
+    )

@@ -1,0 +1,98 @@
+"""Output heads: graph classifier, per-node localisation, anomaly-residual localisation (Eq. 1),
+and the optional severity regressor."""
+
+from __future__ import annotations
+
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+
+def mlp(in_dim: int, hidden: int, out_dim: int, dropout: float = 0.0) -> nn.Sequential:
+    return nn.Sequential(
+        nn.Linear(in_dim, hidden), nn.ReLU(), nn.Dropout(dropout), nn.Linear(hidden, out_dim)
+    )
+
+
+class GraphClassifier(nn.Module):
+    """Mean-pooled node embeddings (+ an MLP of the last joint positions for pose variants)."""
+
+    def __init__(self, hidden: int, num_classes: int, dropout: float, pose_joints: int = 0) -> None:
+        super().__init__()
+        self.pose = mlp(pose_joints, hidden, hidden) if pose_joints else None
+        self.out = mlp(hidden * (2 if pose_joints else 1), hidden, num_classes, dropout)
+
+    def forward(
+        self, nodes: torch.Tensor, joint_positions: torch.Tensor | None = None
+    ) -> torch.Tensor:
+        pooled = nodes.mean(dim=1)
+        if self.pose is not None:
+            pooled = torch.cat([pooled, self.pose(joint_positions)], dim=-1)
+        return self.out(pooled)
+
+
+class NodeLocalisationHead(nn.Module):
+    """Per-node score from refined embeddings + the first-convolution skip; joints only, so a
+    sensor node can never win the localisation argmax."""
+
+    def __init__(self, hidden: int, num_joints: int, dropout: float) -> None:
+        super().__init__()
+        self.num_joints = num_joints
+        self.score = mlp(2 * hidden, hidden, 1, dropout)
+
+    def forward(self, refined: torch.Tensor, skip: torch.Tensor) -> torch.Tensor:
+        joints = slice(0, self.num_joints)
+        return self.score(torch.cat([refined[:, joints], skip[:, joints]], dim=-1)).squeeze(-1)
+
+
+class AnomalyResidualHead(nn.Module):
+    """Learned joint-sensor coupling ``C = softplus(C_logits) in R>=0^{J x M}`` (thesis Eq. 1).
+
+    ``C_pred`` (columns sum to 1 over joints) predicts each sensor embedding from its coupled
+    joints; the residual ``r_m = s_m - f(sum_j C_pred_jm h_j)`` is scored by ``g`` and scattered
+    back through ``C_scat`` (rows sum to 1 over sensors) to joint logits, and ``||r_m||^2`` to a
+    per-joint reconstruction energy for the healthy-data penalty. Works for any M.
+    """
+
+    def __init__(
+        self, hidden: int, num_joints: int, num_sensors: int, init_noise: float = 0.01
+    ) -> None:
+        super().__init__()
+        self.num_joints, self.num_sensors = num_joints, num_sensors
+        self.init_noise = float(init_noise)
+        self.coupling_logits = nn.Parameter(torch.empty(num_joints, num_sensors))
+        self.f = mlp(hidden, hidden, hidden)
+        self.g = mlp(hidden, hidden, 1)
+        self.reset_parameters()
+
+    def reset_parameters(self) -> None:
+        nn.init.normal_(self.coupling_logits, 0.0, self.init_noise)  # near-uniform, no prior
+
+    def coupling(self) -> torch.Tensor:
+        return F.softplus(self.coupling_logits)
+
+    def normalisations(self) -> tuple[torch.Tensor, torch.Tensor]:
+        c = self.coupling()
+        return c / c.sum(dim=0, keepdim=True), c / c.sum(dim=1, keepdim=True)
+
+    def forward(self, nodes: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        h = nodes[:, : self.num_joints]  # [B, J, H]
+        s = nodes[:, self.num_joints :]  # [B, M, H]
+        c_pred, c_scat = self.normalisations()
+        predicted = self.f(torch.einsum("jm,bjh->bmh", c_pred, h))
+        residual = s - predicted
+        scores = self.g(residual).squeeze(-1)  # [B, M]
+        logits = scores @ c_scat.transpose(0, 1)  # [B, J]
+        energy = residual.square().sum(-1) @ c_scat.transpose(0, 1)  # [B, J]
+        return logits, energy
+
+
+class SeverityHead(nn.Module):
+    """Per-window severity in [0, 1] from the pooled embedding (thesis §4.7 extension)."""
+
+    def __init__(self, hidden: int, dropout: float) -> None:
+        super().__init__()
+        self.out = mlp(hidden, hidden, 1, dropout)
+
+    def forward(self, nodes: torch.Tensor) -> torch.Tensor:
+        return torch.sigmoid(self.out(nodes.mean(dim=1))).squeeze(-1)

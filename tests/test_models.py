@@ -1,0 +1,162 @@
+"""The nine model variants: shapes, gradients, the mechanisms' defining properties, ONNX parity."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+from omegaconf import OmegaConf
+
+from robohealth_mj import schema
+from robohealth_mj.models import build_model
+from robohealth_mj.models.onnx import export_onnx, onnx_parity
+
+CONF = Path(__file__).resolve().parents[1] / "conf" / "model"
+VARIANTS = sorted(p.stem for p in CONF.glob("*.yaml"))
+HIDDEN = 16  # small, so the suite stays fast
+
+
+def _build(name: str, window: int = 8, adjacency=None, num_joints: int = 6, **kw):
+    torch.manual_seed(0)
+    cfg = OmegaConf.load(CONF / f"{name}.yaml")
+    cfg.hidden = HIDDEN
+    for key, value in kw.items():
+        cfg[key] = value
+    if "heads" in cfg:
+        cfg.heads = 2
+    adj = schema.adjacency() if adjacency is None else adjacency
+    return build_model(cfg, adj, num_joints, schema.N_FEATURES, window)
+
+
+def test_all_nine_variants_have_configs():
+    assert sorted(
+        [
+            "mlp",
+            "gat",
+            "stgnn_fixed",
+            "stgnn_fixed_pose",
+            "stgnn_learnable",
+            "stgnn_pose_cond",
+            "stgnn_pose_spectral",
+            "anomaly_residual",
+            "pose_anomaly",
+        ]
+    ) == VARIANTS
+
+
+@pytest.mark.parametrize("name", VARIANTS)
+@pytest.mark.parametrize("window", [8, 16, 32, 48])
+def test_output_shapes(name, window):
+    model = _build(name, window).eval()
+    for batch in (1, 128):
+        with torch.no_grad():
+            out = model(torch.randn(batch, window, 12, 9))
+        assert out["class_logits"].shape == (batch, 7)
+        assert out["joint_logits"].shape == (batch, 6)  # joints only: a sensor can never win
+        if "recon_energy" in out:
+            assert out["recon_energy"].shape == (batch, 6)
+        if "gamma" in out:
+            assert out["gamma"].shape == ()
+
+
+@pytest.mark.parametrize("name", VARIANTS)
+def test_gradients_reach_every_parameter(name):
+    model = _build(name, severity_head=True).train()
+    out = model(torch.randn(4, 8, 12, 9))
+    loss = sum(v.float().sum() for v in out.values())
+    loss.backward()
+    missing = [n for n, p in model.named_parameters() if p.grad is None or not p.grad.abs().sum()]
+    assert not missing, missing
+    assert out["severity"].shape == (4,)
+    assert torch.all((out["severity"] >= 0) & (out["severity"] <= 1))
+
+
+def test_mlp_encodes_each_node_on_its_own():
+    model = _build("mlp").eval()
+    x = torch.randn(2, 8, 12, 9)
+    changed = x.clone()
+    changed[:, :, 4] += torch.randn(2, 8, 9)
+    with torch.no_grad():
+        a, b = model.node_embeddings(x), model.node_embeddings(changed)
+    others = [k for k in range(12) if k != 4]
+    torch.testing.assert_close(a[:, others], b[:, others], rtol=0, atol=0)
+    assert not torch.allclose(a[:, 4], b[:, 4])
+
+
+@pytest.mark.parametrize("name", ["stgnn_fixed_pose", "stgnn_pose_cond", "pose_anomaly"])
+def test_gamma_zero_recovers_the_unconditioned_graph(name):
+    model = _build(name).eval()
+    x = torch.randn(3, 8, 12, 9)
+    with torch.no_grad():
+        model.adjacency.pose.gamma.zero_()
+        gated = model(x)
+        model.adjacency.pose = None
+        plain = model(x)
+    for key in ("class_logits", "joint_logits"):
+        torch.testing.assert_close(gated[key], plain[key], rtol=0, atol=1e-6)
+
+
+def test_pose_kernel_gates_backbone_edges_by_pose_difference():
+    model = _build("stgnn_fixed_pose").eval()
+    positions = torch.zeros(1, 12)
+    positions[0, 3] = 1.0  # joint 3 far from its neighbours in pose
+    with torch.no_grad():
+        adj = model.learned_adjacency(positions)[0]
+    assert float(adj[2, 3]) == pytest.approx(np.exp(-1.0), rel=1e-5)
+    assert float(adj[1, 2]) == 1.0 and float(adj[0, 5]) == 0.0
+
+
+@pytest.mark.parametrize("name", ["stgnn_learnable", "stgnn_pose_cond"])
+def test_learned_adjacency_starts_within_0_02_of_the_structural_graph(name):
+    model = _build(name).eval()
+    positions = torch.zeros(2, 12)  # equal poses: the kernel is 1 on every edge
+    with torch.no_grad():
+        learned = model.learned_adjacency(positions)
+    structural = torch.as_tensor(schema.adjacency())
+    assert (learned - structural).abs().max() <= 0.02
+
+
+def test_coupling_normalisations_sum_to_one_along_their_axes():
+    head = _build("anomaly_residual").anomaly
+    with torch.no_grad():
+        head.coupling_logits.normal_(0.0, 2.0)
+    c_pred, c_scat = head.normalisations()
+    torch.testing.assert_close(c_pred.sum(dim=0), torch.ones(6))  # over joints, per sensor
+    torch.testing.assert_close(c_scat.sum(dim=1), torch.ones(6))  # over sensors, per joint
+    assert torch.all(head.coupling() >= 0)
+    fresh = _build("anomaly_residual").anomaly.coupling()
+    assert (fresh.max() - fresh.min()) < 0.05  # near-uniform, no structural prior
+
+
+@pytest.mark.parametrize("name", ["anomaly_residual", "pose_anomaly", "stgnn_fixed", "mlp"])
+def test_four_sensors_mixing_six_joints(name):
+    """The unknown-placement harness: 6 joints + 4 sensors, dense bipartite joint-sensor edges."""
+    adj = np.zeros((10, 10), dtype=np.float32)
+    for j in range(5):
+        adj[j, j + 1] = adj[j + 1, j] = 1.0
+    adj[:6, 6:] = adj[6:, :6] = 1.0
+    model = _build(name, adjacency=adj).eval()
+    with torch.no_grad():
+        out = model(torch.randn(5, 8, 10, 9))
+    assert out["joint_logits"].shape == (5, 6) and out["class_logits"].shape == (5, 7)
+    if hasattr(model, "anomaly") and model.anomaly is not None:
+        assert model.anomaly.coupling().shape == (6, 4)
+
+
+def test_bad_graph_is_a_clear_error():
+    with pytest.raises(ValueError, match="square"):
+        _build("stgnn_fixed", adjacency=np.zeros((12, 11)))
+    with pytest.raises(ValueError, match="num_joints"):
+        _build("stgnn_fixed", num_joints=12)
+
+
+@pytest.mark.parametrize("name", VARIANTS)
+def test_onnx_export_matches_pytorch_with_a_dynamic_batch(name, tmp_path):
+    model = _build(name, window=16, severity_head=(name == "anomaly_residual")).eval()
+    path = tmp_path / f"{name}.onnx"
+    names = export_onnx(model, torch.randn(2, 16, 12, 9), path)
+    assert names[:2] == ["class_logits", "joint_logits"]
+    for batch in (1, 7):
+        assert onnx_parity(model, path, torch.randn(batch, 16, 12, 9)) < 1e-4
