@@ -1,6 +1,7 @@
 """``python -m robohealth_mj.bench``: throughput benchmarks (not tests).
 
     python -m robohealth_mj.bench sim [--duration 60]
+    python -m robohealth_mj.bench models [--windows 16 32] [--variants anomaly_residual ...]
 
 ``sim`` measures, in one run, the raw ``mj_step`` rate of the scene and the recorder's throughput
 (physics + control + sensor synthesis + JSONL writing), and reports their ratio.
@@ -52,6 +53,68 @@ def bench_sim(duration_s: float, overrides: list[str]) -> dict[str, float]:
     }
 
 
+def _latency_ms(fn, calls: int = 200, warmup: int = 10) -> tuple[float, float]:
+    for _ in range(warmup):
+        fn()
+    times = []
+    for _ in range(calls):
+        start = time.perf_counter()
+        fn()
+        times.append((time.perf_counter() - start) * 1e3)
+    return float(np.median(times)), float(np.percentile(times, 95))
+
+
+def bench_models(windows: list[int], variants: list[str]) -> list[dict]:
+    """Parameter count and batch-1 latency (PyTorch eager, onnxruntime) per variant and window."""
+    import onnxruntime as ort
+    import torch
+    from omegaconf import OmegaConf
+
+    from robohealth_mj import schema
+    from robohealth_mj.config import CONF_DIR
+    from robohealth_mj.models import build_model
+    from robohealth_mj.models.onnx import export_onnx
+
+    torch.set_num_threads(1)
+    options = ort.SessionOptions()
+    options.intra_op_num_threads = 1
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in variants:
+            cfg = OmegaConf.load(CONF_DIR / "model" / f"{name}.yaml")
+            for window in windows:
+                torch.manual_seed(0)
+                model = build_model(
+                    cfg, schema.adjacency(), schema.N_JOINTS, schema.N_FEATURES, window
+                ).eval()
+                x = torch.randn(1, window, schema.N_NODES, schema.N_FEATURES)
+                with torch.no_grad():
+                    eager = _latency_ms(lambda m=model, x=x: m(x))
+                path = f"{tmp}/{name}_{window}.onnx"
+                export_onnx(model, x.repeat(2, 1, 1, 1), path)
+                session = ort.InferenceSession(path, options, providers=["CPUExecutionProvider"])
+                feed = {"x": x.numpy()}
+                onnx = _latency_ms(lambda s=session, f=feed: s.run(None, f))
+                rows.append(
+                    {
+                        "variant": name,
+                        "window": window,
+                        "params": sum(p.numel() for p in model.parameters()),
+                        "torch_median_ms": eager[0],
+                        "torch_p95_ms": eager[1],
+                        "ort_median_ms": onnx[0],
+                        "ort_p95_ms": onnx[1],
+                    }
+                )
+                print(
+                    f"{name:<20} W={window:<3} {rows[-1]['params']:>8,} params  "
+                    f"torch {eager[0]:6.3f} ms (p95 {eager[1]:6.3f})  "
+                    f"onnxruntime {onnx[0]:6.3f} ms (p95 {onnx[1]:6.3f})",
+                    flush=True,
+                )
+    return rows
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
         prog="python -m robohealth_mj.bench",
@@ -62,7 +125,19 @@ def main(argv: list[str] | None = None) -> None:
     sim = sub.add_parser("sim", help="raw mj_step rate vs recorder throughput")
     sim.add_argument("--duration", type=float, default=60.0, help="simulated seconds to record")
     sim.add_argument("overrides", nargs="*", help="Hydra overrides for conf/record.yaml")
+    models = sub.add_parser("models", help="parameters and batch-1 CPU latency per variant")
+    models.add_argument("--windows", type=int, nargs="+", default=[16, 32])
+    models.add_argument(
+        "--variants", nargs="+", default=None, help="default: every conf/model/*.yaml"
+    )
     args = parser.parse_args(argv)
+    if args.what == "models":
+        from robohealth_mj.config import CONF_DIR
+
+        variants = args.variants or sorted(p.stem for p in (CONF_DIR / "model").glob("*.yaml"))
+        print("batch-1 latency on one CPU thread: median and p95 of 200 calls after 10 warm-ups")
+        bench_models(args.windows, variants)
+        return
     if args.what == "sim":
         r = bench_sim(args.duration, args.overrides)
         print(

@@ -31,19 +31,22 @@ def _build(name: str, window: int = 8, adjacency=None, num_joints: int = 6, **kw
 
 
 def test_all_nine_variants_have_configs():
-    assert sorted(
-        [
-            "mlp",
-            "gat",
-            "stgnn_fixed",
-            "stgnn_fixed_pose",
-            "stgnn_learnable",
-            "stgnn_pose_cond",
-            "stgnn_pose_spectral",
-            "anomaly_residual",
-            "pose_anomaly",
-        ]
-    ) == VARIANTS
+    assert (
+        sorted(
+            [
+                "mlp",
+                "gat",
+                "stgnn_fixed",
+                "stgnn_fixed_pose",
+                "stgnn_learnable",
+                "stgnn_pose_cond",
+                "stgnn_pose_spectral",
+                "anomaly_residual",
+                "pose_anomaly",
+            ]
+        )
+        == VARIANTS
+    )
 
 
 @pytest.mark.parametrize("name", VARIANTS)
