@@ -1,0 +1,108 @@
+"""The graphs a model can be trained on: the structural schema graph, or the unknown-placement
+harness (thesis §2.6.4) where four off-joint sensors mix the six per-joint sensor packages through
+a ground-truth coupling ``C0 [6, 4]`` that no model is shown.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from robohealth_mj import schema
+
+# Every joint reaches at least one sensor, and every joint's row is distinct, so the six joints
+# stay distinguishable from four sensors.
+DEFAULT_C0 = np.array(
+    [
+        [1.0, 0.0, 0.0, 0.3],
+        [0.7, 0.5, 0.0, 0.0],
+        [0.0, 1.0, 0.3, 0.0],
+        [0.0, 0.4, 1.0, 0.0],
+        [0.0, 0.0, 0.6, 0.7],
+        [0.3, 0.0, 0.0, 1.0],
+    ],
+    dtype=np.float32,
+)
+
+
+@dataclass(frozen=True)
+class GraphSpec:
+    name: str
+    node_names: tuple[str, ...]
+    adjacency: np.ndarray  # [N, N]
+    num_joints: int
+    coupling: np.ndarray | None = None  # C0 [J, M] for the harness
+
+    def transform(self, x: np.ndarray) -> np.ndarray:
+        """Schema snapshots ``[..., 12, 9]`` -> this graph's node features ``[..., N, 9]``."""
+        if self.coupling is None:
+            return x
+        j = schema.N_JOINTS
+        mixed = np.einsum("jm,...jc->...mc", self.coupling, x[..., j:, schema.SENSOR_CHANNELS])
+        sensors = np.zeros((*x.shape[:-2], self.coupling.shape[1], schema.N_FEATURES), np.float32)
+        sensors[..., 1] = 1.0  # is_sensor; joint-state channels stay zero
+        sensors[..., schema.SENSOR_CHANNELS] = mixed
+        return np.concatenate([x[..., :j, :], sensors], axis=-2).astype(np.float32)
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "node_names": list(self.node_names),
+            "adjacency": self.adjacency.tolist(),
+            "num_joints": self.num_joints,
+            "coupling": None if self.coupling is None else self.coupling.tolist(),
+        }
+
+
+def structural_graph() -> GraphSpec:
+    return GraphSpec("structural", schema.NODE_NAMES, schema.adjacency(), schema.N_JOINTS)
+
+
+def load_coupling(path: str | Path) -> np.ndarray:
+    """A ``[6, M]`` non-negative coupling from ``.npy``, ``.json`` or ``.csv``."""
+    path = Path(path)
+    if path.suffix == ".npy":
+        c = np.load(path)
+    elif path.suffix == ".json":
+        c = np.array(json.loads(path.read_text()), dtype=np.float32)
+    else:
+        c = np.loadtxt(path, delimiter=",", dtype=np.float32, ndmin=2)
+    c = np.asarray(c, dtype=np.float32)
+    if c.ndim != 2 or c.shape[0] != schema.N_JOINTS or c.shape[1] < 1:
+        raise ValueError(f"{path}: coupling must be [{schema.N_JOINTS}, M], got {c.shape}")
+    if np.any(c < 0) or np.any(c.sum(axis=1) == 0):
+        raise ValueError(f"{path}: coupling must be >= 0 and every joint must reach a sensor")
+    return c
+
+
+def harness_graph(
+    coupling: np.ndarray | list | None = None, coupling_file: str | None = None
+) -> GraphSpec:
+    """Joints keep their backbone; every joint links to every harness sensor (dense bipartite),
+    so message passing is not told the coupling either. C0: the default, a matrix, or a file."""
+    if coupling_file:
+        c = load_coupling(coupling_file)
+    else:
+        c = DEFAULT_C0 if coupling is None else np.asarray(coupling, dtype=np.float32)
+    j, m = c.shape
+    n = j + m
+    adj = np.zeros((n, n), np.float32)
+    for i in range(j - 1):
+        adj[i, i + 1] = adj[i + 1, i] = 1.0
+    adj[:j, j:] = adj[j:, :j] = 1.0
+    names = schema.JOINT_NAMES + tuple(f"harness_sensor_{k}" for k in range(m))
+    return GraphSpec("harness", names, adj, j, c)
+
+
+def coupling_correlation(learned: np.ndarray, truth: np.ndarray) -> float:
+    """Mean over joints of the Pearson correlation between a joint's learned and true rows."""
+    corr = []
+    for a, b in zip(learned, truth, strict=True):
+        if np.std(a) < 1e-12 or np.std(b) < 1e-12:
+            corr.append(0.0)
+        else:
+            corr.append(float(np.corrcoef(a, b)[0, 1]))
+    return float(np.mean(corr))

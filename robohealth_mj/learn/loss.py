@@ -1,0 +1,38 @@
+"""``CE(graph) + 0.5 BCE(joint head) + 0.1 L_recon`` (+ severity MSE when that head is on)."""
+
+from __future__ import annotations
+
+import torch
+import torch.nn.functional as F
+
+from robohealth_mj.learn.data import WindowBatch
+
+
+def training_loss(
+    out: dict[str, torch.Tensor],
+    batch: WindowBatch,
+    joint_weight: float,
+    recon_weight: float,
+    severity_weight: float,
+) -> tuple[torch.Tensor, dict]:
+    ce = F.cross_entropy(out["class_logits"], batch.fault_class)
+    target = torch.zeros_like(out["joint_logits"])
+    faulted = batch.active.nonzero(as_tuple=True)[0]
+    target[faulted, batch.fault_joint[faulted]] = 1.0  # healthy windows: no joint at fault
+    bce = F.binary_cross_entropy_with_logits(out["joint_logits"], target)
+    loss = ce + joint_weight * bce
+    parts = {"ce": ce.detach(), "bce": bce.detach()}
+    if "recon_energy" in out:
+        healthy = ~batch.active
+        recon = (
+            out["recon_energy"][healthy].sum(-1).mean()
+            if healthy.any()
+            else out["recon_energy"].sum() * 0.0
+        )
+        loss = loss + recon_weight * recon
+        parts["recon"] = recon.detach()
+    if "severity" in out:
+        sev = F.mse_loss(out["severity"], batch.severity)
+        loss = loss + severity_weight * sev
+        parts["severity"] = sev.detach()
+    return loss, parts
