@@ -6,6 +6,7 @@ taken every ``stride`` snapshots and labelled by its *final* snapshot.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,9 +38,7 @@ def make_windows(rec: Recording, window: int, stride: int | None = None) -> Wind
     # contiguous blocks: same run and consecutive sample indices
     breaks = np.flatnonzero((np.diff(rec.run) != 0) | (np.diff(rec.sample_index) != 1)) + 1
     bounds = np.concatenate([[0], breaks, [len(rec)]])
-    starts = [
-        np.arange(a, b - window + 1, stride) for a, b in zip(bounds[:-1], bounds[1:], strict=True)
-    ]
+    starts = [np.arange(a, b - window + 1, stride) for a, b in itertools.pairwise(bounds)]
     return Windows(np.concatenate(starts).astype(np.int64), window)
 
 

@@ -16,15 +16,33 @@ from torch import nn
 from torch_geometric.nn import DenseGCNConv
 
 
+class TimeSharedDropout(nn.Module):
+    """Dropout with one mask per (window, node, channel), shared across the window's snapshots
+    (variational dropout): the same regularisation for the temporal model, at 1/W of the cost of
+    drawing a fresh mask for every snapshot."""
+
+    def __init__(self, p: float) -> None:
+        super().__init__()
+        self.p = float(p)
+
+    def forward(self, h: torch.Tensor, window: int) -> torch.Tensor:
+        if not self.training or self.p == 0.0:
+            return h
+        bw, n, c = h.shape
+        keep = torch.rand(bw // window, 1, n, c, device=h.device) >= self.p
+        mask = keep.to(h.dtype).div_(1.0 - self.p)
+        return (h.reshape(-1, window, n, c) * mask).reshape(bw, n, c)
+
+
 class GraphConvBlock(nn.Module):
     def __init__(self, hidden: int, dropout: float) -> None:
         super().__init__()
         self.conv = DenseGCNConv(hidden, hidden)
         self.norm = nn.LayerNorm(hidden)
-        self.dropout = nn.Dropout(dropout)
+        self.dropout = TimeSharedDropout(dropout)
 
-    def forward(self, h: torch.Tensor, adj: torch.Tensor) -> torch.Tensor:
-        return h + self.dropout(torch.relu(self.norm(self.conv(h, adj))))
+    def forward(self, h: torch.Tensor, adj: torch.Tensor, window: int) -> torch.Tensor:
+        return h + self.dropout(torch.relu(self.norm(self.conv(h, adj))), window)
 
 
 class STBackbone(nn.Module):
@@ -43,8 +61,8 @@ class STBackbone(nn.Module):
         b, w, n, c = h.shape
         flat = h.reshape(b * w, n, c)
         adj_t = adj.unsqueeze(1).expand(b, w, n, n).reshape(b * w, n, n)
-        first = self.conv1(flat, adj_t)
-        second = self.conv2(first, adj_t)
+        first = self.conv1(flat, adj_t, w)
+        second = self.conv2(first, adj_t, w)
         seq = second.reshape(b, w, n, c).transpose(1, 2).reshape(b * n, w, c)
         _, last = self.gru(seq)
         temporal = last[-1].reshape(b, n, c)

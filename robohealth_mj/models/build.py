@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 from hydra.utils import instantiate
-from omegaconf import DictConfig
+from omegaconf import DictConfig, OmegaConf
 from torch import nn
 
 
@@ -23,8 +23,14 @@ def build_model(
         raise ValueError(f"adjacency must be square [N, N], got {tuple(adjacency.shape)}")
     if not 0 < num_joints < adjacency.shape[0]:
         raise ValueError(f"num_joints={num_joints} must leave at least one sensor node")
+    cfg = (
+        OmegaConf.to_container(model_cfg, resolve=True)
+        if isinstance(model_cfg, DictConfig)
+        else dict(model_cfg)
+    )
+    cfg.pop("name", None)  # the variant's name, for records; not a constructor argument
     return instantiate(
-        model_cfg,
+        cfg,
         adjacency=adjacency,
         num_joints=num_joints,
         in_features=in_features,
