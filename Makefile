@@ -1,5 +1,7 @@
 # Two commands for a fresh machine (Python 3.11 is all it needs):
-#   make run    set up .venv, record the quick corpus and print its summary (the gate)
+#   make run    set up .venv and run the whole pipeline on the quick corpus: record, gate, train
+#               mlp / stgnn_fixed / anomaly_residual (structural graph and harness), evaluate,
+#               print the results table (about 7 minutes on 2 cores)
 #   make test   set up .venv and run the test suite
 PYTHON ?= python3
 VENV   := .venv
@@ -20,7 +22,9 @@ $(STAMP): pyproject.toml
 
 run: setup
 	$(BIN)/python -m robohealth_mj.corpus corpus=quick
-	$(BIN)/python -m robohealth_mj.dataset summarize outputs/corpus/quick/*/
+	$(BIN)/python -m robohealth_mj.dataset summarize outputs/corpus/quick/*/ > outputs/corpus/quick/summary.txt
+	$(BIN)/python -m robohealth_mj.train -m +experiment=quick
+	$(BIN)/python -m robohealth_mj.report outputs/campaign_quick
 
 test: setup
 	$(BIN)/python -m pytest

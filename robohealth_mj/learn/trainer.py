@@ -87,6 +87,8 @@ def train_run(cfg: DictConfig, out_dir: Path) -> dict[str, Any]:
 
     out_dir.mkdir(parents=True, exist_ok=True)
     seed_everything(int(cfg.seed))
+    if cfg.trainer.get("threads"):
+        torch.set_num_threads(int(cfg.trainer.threads))
     device = pick_device(cfg.trainer.device)
     t = cfg.trainer
     graph: GraphSpec = instantiate(cfg.graph)
