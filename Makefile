@@ -22,7 +22,7 @@ $(STAMP): pyproject.toml
 
 run: setup
 	$(BIN)/python -m robohealth_mj.corpus corpus=quick
-	$(BIN)/python -m robohealth_mj.dataset summarize outputs/corpus/quick/*/ > outputs/corpus/quick/summary.txt
+	$(BIN)/python -m robohealth_mj.dataset summarize outputs/corpus/quick/*/
 	$(BIN)/python -m robohealth_mj.train -m +experiment=quick
 	$(BIN)/python -m robohealth_mj.report outputs/campaign_quick
 

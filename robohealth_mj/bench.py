@@ -2,6 +2,7 @@
 
     python -m robohealth_mj.bench sim [--duration 60]
     python -m robohealth_mj.bench models [--windows 16 32] [--variants anomaly_residual ...]
+    python -m robohealth_mj.bench train [--data 'outputs/corpus/quick/train_*'] [--window 16]
 
 ``sim`` measures, in one run, the raw ``mj_step`` rate of the scene and the recorder's throughput
 (physics + control + sensor synthesis + JSONL writing), and reports their ratio.
@@ -115,6 +116,106 @@ def bench_models(windows: list[int], variants: list[str]) -> list[dict]:
     return rows
 
 
+def matmul_rate(seconds: float = 2.0, n: int = 1024) -> float:
+    """Single-precision matmul FLOP/s of this machine (all torch threads)."""
+    import torch
+
+    a, b = torch.randn(n, n), torch.randn(n, n)
+    a @ b
+    calls, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        a @ b
+        calls += 1
+    return 2.0 * n**3 * calls / (time.perf_counter() - start)
+
+
+def bench_train(
+    data: list[str], variants: list[str], window: int, steps: int, batch: int
+) -> list[dict]:
+    """Training throughput per variant on real windows; data loading timed separately."""
+    import torch
+    from omegaconf import OmegaConf
+    from torch.utils.flop_counter import FlopCounterMode
+
+    from robohealth_mj import schema
+    from robohealth_mj.config import CONF_DIR, compose_config
+    from robohealth_mj.data.arrays import load_recordings
+    from robohealth_mj.data.windows import make_windows, normalisation
+    from robohealth_mj.learn.data import WindowTensors
+    from robohealth_mj.learn.loss import training_loss
+    from robohealth_mj.learn.trainer import expand_paths
+    from robohealth_mj.models import build_model
+
+    t0 = time.perf_counter()
+    rec = load_recordings(expand_paths(data))
+    load_s = time.perf_counter() - t0
+    windows = make_windows(rec, window)
+    mean, std = normalisation(rec.x, windows)
+    tensors = WindowTensors(rec.x, rec, mean, std, torch.device("cpu"))
+    peak = matmul_rate()
+    weights = compose_config("train").trainer
+    print(
+        f"data: {len(rec)} samples, {len(windows)} windows; loading from the binary cache "
+        f"{load_s:.2f} s; matmul rate {peak / 1e9:.0f} GFLOP/s; batch {batch}, W={window}"
+    )
+    rows = []
+    rng = np.random.default_rng(0)
+    for name in variants:
+        torch.manual_seed(0)
+        model = build_model(
+            OmegaConf.load(CONF_DIR / "model" / f"{name}.yaml"),
+            schema.adjacency(),
+            schema.N_JOINTS,
+            schema.N_FEATURES,
+            window,
+        )
+        opt = torch.optim.Adam(model.parameters(), lr=1e-3)
+
+        def step(b, model=model, opt=opt):
+            loss, _ = training_loss(
+                model(b.x),
+                b,
+                weights.joint_loss_weight,
+                weights.recon_loss_weight,
+                weights.severity_loss_weight,
+            )
+            opt.zero_grad(set_to_none=True)
+            loss.backward()
+            opt.step()
+
+        first = tensors.batch(windows, rng.integers(0, len(windows), batch))
+        with FlopCounterMode(display=False) as counter:
+            step(first)
+        flops_per_window = counter.get_total_flops() / batch
+        for _ in range(3):
+            step(first)
+        gather = compute = 0.0
+        for _ in range(steps):
+            t = time.perf_counter()
+            b = tensors.batch(windows, rng.integers(0, len(windows), batch))
+            gather += time.perf_counter() - t
+            t = time.perf_counter()
+            step(b)
+            compute += time.perf_counter() - t
+        total = gather + compute
+        rate = steps * batch / total
+        row = {
+            "variant": name,
+            "windows_per_s": rate,
+            "data_share": gather / total,
+            "flops_per_window": flops_per_window,
+            "flop_fraction": rate * flops_per_window / peak,
+        }
+        rows.append(row)
+        print(
+            f"{name:<20} {rate:>8,.0f} windows/s  data {row['data_share']:6.1%}  "
+            f"{flops_per_window / 1e6:6.1f} MFLOP/window  {row['flop_fraction']:6.1%} of "
+            f"matmul rate",
+            flush=True,
+        )
+    return rows
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
         prog="python -m robohealth_mj.bench",
@@ -130,7 +231,16 @@ def main(argv: list[str] | None = None) -> None:
     models.add_argument(
         "--variants", nargs="+", default=None, help="default: every conf/model/*.yaml"
     )
+    train = sub.add_parser("train", help="training throughput per variant")
+    train.add_argument("--data", nargs="+", default=["outputs/corpus/quick/train_*"])
+    train.add_argument("--variants", nargs="+", default=["mlp", "stgnn_fixed", "anomaly_residual"])
+    train.add_argument("--window", type=int, default=16)
+    train.add_argument("--steps", type=int, default=20)
+    train.add_argument("--batch", type=int, default=128)
     args = parser.parse_args(argv)
+    if args.what == "train":
+        bench_train(args.data, args.variants, args.window, args.steps, args.batch)
+        return
     if args.what == "models":
         from robohealth_mj.config import CONF_DIR
 
