@@ -19,19 +19,10 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj.atomic import atomic_write_text
+from robohealth_mj.models import VARIANTS
 from robohealth_mj.schema import FAULT_CLASSES
 
-VARIANT_ORDER = (
-    "mlp",
-    "gat",
-    "stgnn_fixed",
-    "stgnn_fixed_pose",
-    "stgnn_learnable",
-    "stgnn_pose_cond",
-    "stgnn_pose_spectral",
-    "anomaly_residual",
-    "pose_anomaly",
-)
+VARIANT_ORDER = VARIANTS
 COLUMNS = (
     ("heldout", "accuracy"),
     ("heldout", "fault_present_accuracy"),

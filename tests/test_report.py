@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 from robohealth_mj.report import build_report
+from robohealth_mj.schema import FAULT_CLASSES
 
 
 def _run(
@@ -32,16 +33,7 @@ def _run(
         )
     )
     per_class = {
-        c: {"precision": 0.5, "recall": 0.5, "f1": 0.5, "support": 1}
-        for c in (
-            "none",
-            "backlash",
-            "friction",
-            "jam",
-            "struct_weaken",
-            "sensor_drift",
-            "sensor_noise",
-        )
+        c: {"precision": 0.5, "recall": 0.5, "f1": 0.5, "support": 1} for c in FAULT_CLASSES
     }
     metrics = {
         "accuracy": acc,

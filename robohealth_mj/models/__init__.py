@@ -7,4 +7,17 @@ a dict with ``class_logits [B, 7]``, ``joint_logits [B, J]`` and, where present,
 
 from robohealth_mj.models.build import build_model
 
-__all__ = ["build_model"]
+# The nine variants in the thesis's Table 3 order (each has conf/model/<name>.yaml).
+VARIANTS: tuple[str, ...] = (
+    "mlp",
+    "gat",
+    "stgnn_fixed",
+    "stgnn_fixed_pose",
+    "stgnn_learnable",
+    "stgnn_pose_cond",
+    "stgnn_pose_spectral",
+    "anomaly_residual",
+    "pose_anomaly",
+)
+
+__all__ = ["VARIANTS", "build_model"]
