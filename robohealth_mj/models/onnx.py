@@ -6,6 +6,7 @@ size into the reshapes of the spatio-temporal backbone and breaks parity at othe
 
 from __future__ import annotations
 
+import logging
 import warnings
 from pathlib import Path
 
@@ -45,6 +46,8 @@ def export_onnx(
     """Write ``path`` with input ``x: float32[batch, W, N, F]``; returns the output names."""
     wrapper = ExportWrapper(model, pre).eval()
     batch = torch.export.Dim("batch", min=1, max=65536)
+    for name in ("onnx_ir", "onnxscript", "torch.onnx"):  # their INFO lines are not ours to print
+        logging.getLogger(name).setLevel(logging.WARNING)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         torch.onnx.export(
