@@ -140,15 +140,20 @@ def main(argv: list[str] | None = None) -> dict | None:
         stamp = datetime.now().strftime("%Y-%m-%d_%H-%M-%S")
         out = Path(cfg.out or Path("outputs/monitor") / stamp / "online_eval.json")
         atomic_write_json(out, result)
-        acc, loc, fa = (
-            result[k] for k in ("online_accuracy", "localisation_accuracy", "false_alarm_rate")
-        )
         lat = result["detection_latency"]
         print(
-            f"on-line accuracy {acc}  localisation {loc}  false alarms {fa}  "
-            f"class latency {lat['class_latency_s_mean']} s  joint latency "
-            f"{lat['joint_latency_s_mean']} s over {result['episodes']} episodes -> {out}"
+            f"on-line accuracy {_num(result['online_accuracy'])}  localisation "
+            f"{_num(result['localisation_accuracy'])}  false alarms "
+            f"{_num(result['false_alarm_rate'])}  class latency "
+            f"{_num(lat['class_latency_s_mean'])} s  joint latency {_num(lat['joint_latency_s_mean'])} s over {result['episodes']} "
+            f"episodes -> {out}"
         )
+        return result
+    return None
+
+
+def _num(value: float | None) -> str:
+    return "n/a" if value is None else f"{value:.3f}"
 
 
 if __name__ == "__main__":
