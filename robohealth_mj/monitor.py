@@ -145,8 +145,8 @@ def main(argv: list[str] | None = None) -> dict | None:
             f"on-line accuracy {_num(result['online_accuracy'])}  localisation "
             f"{_num(result['localisation_accuracy'])}  false alarms "
             f"{_num(result['false_alarm_rate'])}  class latency "
-            f"{_num(lat['class_latency_s_mean'])} s  joint latency {_num(lat['joint_latency_s_mean'])} s over {result['episodes']} "
-            f"episodes -> {out}"
+            f"{_num(lat['class_latency_s_mean'])} s  joint latency "
+            f"{_num(lat['joint_latency_s_mean'])} s over {result['episodes']} episodes -> {out}"
         )
         return result
     return None
