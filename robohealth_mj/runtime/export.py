@@ -103,33 +103,63 @@ def export_checkpoint(
             f"> {PARITY_TOLERANCE} on {len(windows)} held-out windows"
         )
     fingerprint = file_fingerprint(ckpt_path)
-    metadata = {
-        "model_id": f"{ckpt['variant']}-{graph.name}-w{ckpt['window']}-{fingerprint[:8]}",
-        "variant": ckpt["variant"],
-        "graph": graph.name,
-        "schema_version": schema.SCHEMA_VERSION,
-        "node_names": json.dumps(list(schema.NODE_NAMES)),
-        "feature_names": json.dumps(list(schema.FEATURE_NAMES)),
-        "edges": json.dumps([list(e) for e in schema.EDGES]),
-        "window": str(ckpt["window"]),
-        "classes": json.dumps(ckpt["labels"]["classes"]),
-        "joints": json.dumps(ckpt["labels"]["joints"]),
-        "outputs": json.dumps(outputs),
-        "checkpoint_fingerprint": fingerprint,
-        "data_fingerprint": ckpt["data_fingerprint"],
-        "code_version": ckpt["code_version"],
-        "parity_max_abs_error": f"{error:.3g}",
-    }
-    proto = onnx.load(str(tmp))
-    tmp.unlink()
-    onnx.helper.set_model_props(proto, metadata)
-    atomic_write_bytes(out, proto.SerializeToString())
+    metadata = model_metadata(
+        model_id=f"{ckpt['variant']}-{graph.name}-w{ckpt['window']}-{fingerprint[:8]}",
+        variant=ckpt["variant"],
+        graph=graph.name,
+        window=int(ckpt["window"]),
+        outputs=outputs,
+        classes=ckpt["labels"]["classes"],
+        joints=ckpt["labels"]["joints"],
+        checkpoint_fingerprint=fingerprint,
+        data_fingerprint=ckpt["data_fingerprint"],
+        code_version=ckpt["code_version"],
+        parity_max_abs_error=f"{error:.3g}",
+    )
+    attach_metadata(tmp, out, metadata)
     return {
         "path": str(out),
         "parity_max_abs_error": error,
         "windows": len(windows),
         "metadata": metadata,
     }
+
+
+def model_metadata(
+    *,
+    model_id: str,
+    variant: str,
+    graph: str,
+    window: int,
+    outputs: list[str],
+    classes: list[str] | None = None,
+    joints: list[str] | None = None,
+    **extra: str,
+) -> dict[str, str]:
+    """The ONNX metadata the runtime checks and reports (all values are strings)."""
+    return {
+        "model_id": model_id,
+        "variant": variant,
+        "graph": graph,
+        "schema_version": schema.SCHEMA_VERSION,
+        "node_names": json.dumps(list(schema.NODE_NAMES)),
+        "feature_names": json.dumps(list(schema.FEATURE_NAMES)),
+        "edges": json.dumps([list(e) for e in schema.EDGES]),
+        "window": str(window),
+        "classes": json.dumps(classes or list(schema.FAULT_CLASSES)),
+        "joints": json.dumps(joints or list(schema.JOINT_NAMES)),
+        "outputs": json.dumps(outputs),
+        **extra,
+    }
+
+
+def attach_metadata(src: Path | str, out: Path | str, metadata: dict[str, str]) -> None:
+    """Write ``src`` with ``metadata`` to ``out`` atomically (``src`` removed if different)."""
+    proto = onnx.load(str(src))
+    onnx.helper.set_model_props(proto, metadata)
+    atomic_write_bytes(out, proto.SerializeToString())
+    if Path(src) != Path(out):
+        Path(src).unlink()
 
 
 def read_metadata(path: Path | str) -> dict[str, Any]:
