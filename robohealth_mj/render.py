@@ -34,6 +34,17 @@ def load_config(argv: list[str]) -> DictConfig:
     return OmegaConf.merge(cfg, OmegaConf.from_dotlist(argv))
 
 
+def localisation_tint(joint_scores: dict[str, float]) -> np.ndarray:
+    """Per-joint tint in [0, 1]: how far the joint's share of the localisation evidence
+    (a softmax over the joint logits) rises above uniform. Flat evidence tints nothing."""
+    s = np.clip(np.array(list(joint_scores.values())), 1e-6, 1 - 1e-6)
+    logits = np.log(s / (1 - s))
+    p = np.exp(logits - logits.max())
+    p /= p.sum()
+    uniform = 1.0 / len(p)
+    return np.clip((p - uniform) / (1.0 - uniform), 0.0, 1.0)
+
+
 def render_episode(cfg: DictConfig) -> list:
     from PIL import Image
 
@@ -82,9 +93,7 @@ def render_episode(cfg: DictConfig) -> list:
         else:
             where = f" @ {d.localised_joint}" if d.fault_present else ""
             diag_text = f"MODEL {d.fault_class}{where}  p={d.confidence:.2f}"
-            raw = np.array(list(d.joint_scores.values()))
-            # relative to the most suspect joint: the localised joint is fully red
-            scores = raw / max(raw.max(), 1e-9) if d.fault_present else None
+            scores = localisation_tint(d.joint_scores) if d.fault_present else None
         image = view.render(
             sim.data,
             scores,
