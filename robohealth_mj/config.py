@@ -7,7 +7,7 @@ from pathlib import Path
 
 from hydra import compose, initialize_config_dir
 from hydra.core.global_hydra import GlobalHydra
-from omegaconf import DictConfig
+from omegaconf import DictConfig, OmegaConf
 
 CONF_DIR = Path(__file__).resolve().parents[1] / "conf"
 
@@ -19,3 +19,17 @@ def compose_config(name: str, overrides: Sequence[str] = ()) -> DictConfig:
         cfg = compose(config_name=name, overrides=list(overrides))
     GlobalHydra.instance().clear()
     return cfg
+
+
+def load_cli_config(name: str, argv: Sequence[str], prog: str) -> DictConfig:
+    """``conf/<name>.yaml`` with ``key=value`` overrides, for the small tools that are not Hydra
+    apps (``model=`` there names a file, not the training ``model`` config group)."""
+    cfg = OmegaConf.load(CONF_DIR / f"{name}.yaml")
+    keys = [a.split("=", 1)[0] for a in argv]
+    unknown = [k for k in keys if k not in cfg]
+    if unknown or any("=" not in a for a in argv):
+        raise SystemExit(
+            f"usage: python -m {prog} key=value ... (keys: {', '.join(cfg)}); "
+            f"not understood: {unknown or list(argv)}"
+        )
+    return OmegaConf.merge(cfg, OmegaConf.from_dotlist(list(argv)))

@@ -16,10 +16,10 @@ from collections.abc import Iterator
 from datetime import datetime
 from pathlib import Path
 
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from robohealth_mj.atomic import atomic_write_json
-from robohealth_mj.config import CONF_DIR, compose_config
+from robohealth_mj.config import compose_config, load_cli_config
 from robohealth_mj.data.jsonl import format_line, node_features
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
@@ -83,16 +83,7 @@ def describe(d: HealthDiagnosis) -> str:
 
 
 def load_config(argv: list[str]) -> DictConfig:
-    """``conf/monitor.yaml`` with ``key=value`` overrides (not a Hydra app: ``model=`` here is
-    a file, not the ``model`` config group of training)."""
-    cfg = OmegaConf.load(CONF_DIR / "monitor.yaml")
-    unknown = [a.split("=", 1)[0] for a in argv if a.split("=", 1)[0] not in cfg]
-    if unknown or any("=" not in a for a in argv):
-        raise SystemExit(
-            f"usage: python -m robohealth_mj.monitor key=value ... "
-            f"(keys: {', '.join(cfg)}); unknown: {unknown or argv}"
-        )
-    return OmegaConf.merge(cfg, OmegaConf.from_dotlist(argv))
+    return load_cli_config("monitor", argv, "robohealth_mj.monitor")
 
 
 def main(argv: list[str] | None = None) -> dict | None:

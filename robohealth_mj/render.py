@@ -18,20 +18,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
-from robohealth_mj.config import CONF_DIR, compose_config
+from robohealth_mj.config import compose_config, load_cli_config
 
 
 def load_config(argv: list[str]) -> DictConfig:
-    cfg = OmegaConf.load(CONF_DIR / "render.yaml")
-    unknown = [a.split("=", 1)[0] for a in argv if a.split("=", 1)[0] not in cfg]
-    if unknown or any("=" not in a for a in argv):
-        raise SystemExit(
-            f"usage: python -m robohealth_mj.render key=value ... "
-            f"(keys: {', '.join(cfg)}); unknown: {unknown or argv}"
-        )
-    return OmegaConf.merge(cfg, OmegaConf.from_dotlist(argv))
+    return load_cli_config("render", argv, "robohealth_mj.render")
 
 
 def localisation_tint(joint_scores: dict[str, float]) -> np.ndarray:
