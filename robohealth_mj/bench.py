@@ -56,6 +56,18 @@ def bench_sim(duration_s: float, overrides: list[str]) -> dict[str, float]:
     }
 
 
+def _variant(name: str, window: int):
+    """A freshly initialised model of ``conf/model/<name>.yaml`` on the schema graph."""
+    from omegaconf import OmegaConf
+
+    from robohealth_mj import schema
+    from robohealth_mj.config import CONF_DIR
+    from robohealth_mj.models import build_model
+
+    cfg = OmegaConf.load(CONF_DIR / "model" / f"{name}.yaml")
+    return build_model(cfg, schema.adjacency(), schema.N_JOINTS, schema.N_FEATURES, window)
+
+
 def _latency_ms(fn, calls: int = 200, warmup: int = 10) -> tuple[float, float]:
     """Median and p95 wall time of ``calls`` calls after ``warmup`` untimed ones (ms)."""
     for _ in range(warmup):
@@ -72,11 +84,8 @@ def bench_models(windows: list[int], variants: list[str]) -> list[dict]:
     """Parameter count and batch-1 latency (PyTorch eager, onnxruntime) per variant and window."""
     import onnxruntime as ort
     import torch
-    from omegaconf import OmegaConf
 
     from robohealth_mj import schema
-    from robohealth_mj.config import CONF_DIR
-    from robohealth_mj.models import build_model
     from robohealth_mj.models.onnx import export_onnx
 
     torch.set_num_threads(1)
@@ -85,12 +94,9 @@ def bench_models(windows: list[int], variants: list[str]) -> list[dict]:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in variants:
-            cfg = OmegaConf.load(CONF_DIR / "model" / f"{name}.yaml")
             for window in windows:
                 torch.manual_seed(0)
-                model = build_model(
-                    cfg, schema.adjacency(), schema.N_JOINTS, schema.N_FEATURES, window
-                ).eval()
+                model = _variant(name, window).eval()
                 x = torch.randn(1, window, schema.N_NODES, schema.N_FEATURES)
                 with torch.no_grad():
                     eager = _latency_ms(lambda m=model, x=x: m(x))
@@ -137,17 +143,14 @@ def bench_train(
 ) -> list[dict]:
     """Training throughput per variant on real windows; data loading timed separately."""
     import torch
-    from omegaconf import OmegaConf
     from torch.utils.flop_counter import FlopCounterMode
 
-    from robohealth_mj import schema
-    from robohealth_mj.config import CONF_DIR, compose_config
+    from robohealth_mj.config import compose_config
     from robohealth_mj.data.arrays import load_recordings
     from robohealth_mj.data.windows import make_windows, normalisation
     from robohealth_mj.learn.data import WindowTensors
     from robohealth_mj.learn.loss import training_loss
     from robohealth_mj.learn.trainer import expand_paths
-    from robohealth_mj.models import build_model
 
     t0 = time.perf_counter()
     rec = load_recordings(expand_paths(data))
@@ -165,13 +168,7 @@ def bench_train(
     rng = np.random.default_rng(0)
     for name in variants:
         torch.manual_seed(0)
-        model = build_model(
-            OmegaConf.load(CONF_DIR / "model" / f"{name}.yaml"),
-            schema.adjacency(),
-            schema.N_JOINTS,
-            schema.N_FEATURES,
-            window,
-        )
+        model = _variant(name, window)
         opt = torch.optim.Adam(model.parameters(), lr=1e-3)
 
         def step(b, model=model, opt=opt):
@@ -266,15 +263,11 @@ def bench_infer(data: list[str], variants: list[str], window: int, batch: int) -
     """Latency and throughput of every deployable variant on real held-out windows."""
     import onnxruntime as ort
     import torch
-    from omegaconf import OmegaConf
     from torch.utils.flop_counter import FlopCounterMode
 
-    from robohealth_mj import schema
-    from robohealth_mj.config import CONF_DIR
     from robohealth_mj.data.arrays import load_recordings
     from robohealth_mj.data.windows import make_windows, normalisation
     from robohealth_mj.learn.trainer import expand_paths
-    from robohealth_mj.models import build_model
     from robohealth_mj.models.onnx import export_onnx
     from robohealth_mj.runtime.export import RawInput, attach_metadata, model_metadata
 
@@ -292,13 +285,7 @@ def bench_infer(data: list[str], variants: list[str], window: int, batch: int) -
     with tempfile.TemporaryDirectory() as tmp:
         for name in variants:
             torch.manual_seed(0)
-            model = build_model(
-                OmegaConf.load(CONF_DIR / "model" / f"{name}.yaml"),
-                schema.adjacency(),
-                schema.N_JOINTS,
-                schema.N_FEATURES,
-                window,
-            ).eval()
+            model = _variant(name, window).eval()
             pre = RawInput(torch.from_numpy(mean), torch.from_numpy(std), None).eval()
             with FlopCounterMode(display=False) as counter, torch.no_grad():
                 model(pre(raw[:1]))

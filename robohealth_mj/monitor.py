@@ -20,7 +20,6 @@ from omegaconf import DictConfig
 
 from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.config import compose_config, load_cli_config
-from robohealth_mj.data.jsonl import format_line, node_features
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 from robohealth_mj.schema import FaultLabel, validate_sample
@@ -28,27 +27,11 @@ from robohealth_mj.schema import FaultLabel, validate_sample
 
 def sim_stream(overrides: list[str], duration_s: float) -> Iterator[tuple[float, str]]:
     """GraphSample lines straight from the simulator (with its fault schedule)."""
-    from robohealth_mj.recorder import build_simulator
+    from robohealth_mj.recorder import build_simulator, chunk_lines
 
     sim = build_simulator(compose_config("record", ["session.progress=false", *overrides]))
-    index = 0
     for chunk in sim.run(round(duration_s / sim.tick_s)):
-        seg = sim.curriculum.scheduled(chunk.visit).segment
-        segment = {
-            "index": seg.index,
-            "family": seg.family,
-            "speed_scale": seg.speed_scale,
-            "payload_scale": seg.payload_scale,
-        }
-        for k in range(len(chunk.t)):
-            x = node_features(
-                chunk.pos[k], chunk.vel[k], chunk.effort[k], chunk.vib[k], chunk.acc[k]
-            )
-            yield (
-                float(chunk.t[k]),
-                format_line("sim", index, float(chunk.t[k]), x, chunk.fault, segment),
-            )
-            index += 1
+        yield from zip(chunk.t.tolist(), chunk_lines(sim, chunk, "sim"), strict=True)
 
 
 def replay_stream(path: str) -> Iterator[tuple[float, str]]:

@@ -239,9 +239,10 @@ def _session_ticks(cfg: DictConfig, sim: ArmSimulator) -> int:
     return round(duration / sim.tick_s)
 
 
-def _chunk_lines(sim: ArmSimulator, chunk: TickChunk, run_id: str, stats: SessionStats) -> str:
+def segment_info(sim: ArmSimulator, chunk: TickChunk) -> dict[str, Any]:
+    """The curriculum fields every GraphSample of a chunk carries."""
     seg = sim.curriculum.scheduled(chunk.visit).segment
-    segment = {
+    return {
         "index": seg.index,
         "visit": chunk.visit,
         "family": seg.family,
@@ -249,14 +250,28 @@ def _chunk_lines(sim: ArmSimulator, chunk: TickChunk, run_id: str, stats: Sessio
         "speed_scale": seg.speed_scale,
         "payload_scale": seg.payload_scale,
     }
-    fault = chunk.fault
-    stats.add(chunk, segment, fault)
+
+
+def chunk_lines(sim: ArmSimulator, chunk: TickChunk, run_id: str) -> list[str]:
+    """One GraphSample JSON line per tick of a just-simulated chunk."""
+    segment = segment_info(sim, chunk)
     first = sim.tick - len(chunk.t)
-    lines = []
-    for k in range(len(chunk.t)):
-        x = node_features(chunk.pos[k], chunk.vel[k], chunk.effort[k], chunk.vib[k], chunk.acc[k])
-        lines.append(format_line(run_id, first + k, float(chunk.t[k]), x, fault, segment))
-    return "".join(lines)
+    return [
+        format_line(
+            run_id,
+            first + k,
+            float(chunk.t[k]),
+            node_features(chunk.pos[k], chunk.vel[k], chunk.effort[k], chunk.vib[k], chunk.acc[k]),
+            chunk.fault,
+            segment,
+        )
+        for k in range(len(chunk.t))
+    ]
+
+
+def _chunk_lines(sim: ArmSimulator, chunk: TickChunk, run_id: str, stats: SessionStats) -> str:
+    stats.add(chunk, segment_info(sim, chunk), chunk.fault)
+    return "".join(chunk_lines(sim, chunk, run_id))
 
 
 def summary_text(result: RecordingResult) -> str:
