@@ -1,4 +1,5 @@
-"""The nine model variants: shapes, gradients, the mechanisms' defining properties, ONNX parity."""
+"""The nine network variants on both backbones: shapes, gradients, the mechanisms' defining
+properties, ONNX parity."""
 
 from __future__ import annotations
 
@@ -10,18 +11,31 @@ import torch
 from omegaconf import OmegaConf
 
 from robohealth_mj import schema
-from robohealth_mj.models import VARIANTS as MODEL_VARIANTS
-from robohealth_mj.models import build_model
+from robohealth_mj.config import compose_config
+from robohealth_mj.models import NETWORK_VARIANTS, build_model
+from robohealth_mj.models import VARIANTS as ALL_VARIANTS
+from robohealth_mj.models.backbone import ThesisBackbone, WindowBackbone
 from robohealth_mj.models.onnx import export_onnx, onnx_parity
 
-CONF = Path(__file__).resolve().parents[1] / "conf" / "model"
-VARIANTS = sorted(p.stem for p in CONF.glob("*.yaml"))
+ROOT = Path(__file__).resolve().parents[1] / "conf"
+CONF = ROOT / "model"
+VARIANTS = sorted(p.stem for p in CONF.glob("*.yaml") if p.stem != "gbdt")
 HIDDEN = 16  # small, so the suite stays fast
 
 
-def _build(name: str, window: int = 8, adjacency=None, num_joints: int = 6, **kw):
+def _build(
+    name: str,
+    window: int = 8,
+    adjacency=None,
+    num_joints: int = 6,
+    backbone: str = "window",
+    **kw,
+):
     torch.manual_seed(0)
-    cfg = OmegaConf.load(CONF / f"{name}.yaml")
+    cfg = OmegaConf.merge(
+        OmegaConf.load(CONF / f"{name}.yaml"),
+        OmegaConf.load(ROOT / "backbone" / f"{backbone}.yaml"),
+    )
     cfg.hidden = HIDDEN
     for key, value in kw.items():
         cfg[key] = value
@@ -31,15 +45,19 @@ def _build(name: str, window: int = 8, adjacency=None, num_joints: int = 6, **kw
     return build_model(cfg, adj, num_joints, schema.N_FEATURES, window)
 
 
-def test_all_nine_variants_have_configs():
+def test_all_nine_networks_and_the_baseline_have_configs():
     assert len(VARIANTS) == 9
-    assert sorted(MODEL_VARIANTS) == VARIANTS
+    assert sorted(NETWORK_VARIANTS) == VARIANTS
+    assert ALL_VARIANTS[0] == "gbdt" and (CONF / "gbdt.yaml").is_file()
+
+
+SHAPE_CASES = [("window", w) for w in (8, 16, 32, 48)] + [("thesis", w) for w in (8, 32)]
 
 
 @pytest.mark.parametrize("name", VARIANTS)
-@pytest.mark.parametrize("window", [8, 16, 32, 48])
-def test_output_shapes(name, window):
-    model = _build(name, window).eval()
+@pytest.mark.parametrize(("backbone", "window"), SHAPE_CASES)
+def test_output_shapes(name, window, backbone):
+    model = _build(name, window, backbone=backbone).eval()
     for batch in (1, 128):
         with torch.no_grad():
             out = model(torch.randn(batch, window, 12, 9))
@@ -51,9 +69,10 @@ def test_output_shapes(name, window):
             assert out["gamma"].shape == ()
 
 
+@pytest.mark.parametrize("backbone", ["window", "thesis"])
 @pytest.mark.parametrize("name", VARIANTS)
-def test_gradients_reach_every_parameter(name):
-    model = _build(name, severity_head=True).train()
+def test_gradients_reach_every_parameter(name, backbone):
+    model = _build(name, severity_head=True, backbone=backbone).train()
     out = model(torch.randn(4, 8, 12, 9))
     loss = sum(v.float().sum() for v in out.values())
     loss.backward()
@@ -63,8 +82,25 @@ def test_gradients_reach_every_parameter(name):
     assert torch.all((out["severity"] >= 0) & (out["severity"] <= 1))
 
 
-def test_mlp_encodes_each_node_on_its_own():
-    model = _build("mlp").eval()
+def test_the_default_backbone_is_the_window_one_and_thesis_rebuilds_the_thesis_model():
+    """``backbone=thesis`` composes the thesis's per-snapshot GCN + GRU + attention."""
+
+    def composed(*overrides):
+        cfg = compose_config("train", ["variant=stgnn_fixed", *overrides])
+        return build_model(cfg.model, schema.adjacency(), 6, schema.N_FEATURES, 16)
+
+    window = composed()
+    assert isinstance(window.backbone, WindowBackbone) and window.classifier.max_pool
+    thesis = composed("backbone=thesis")
+    assert isinstance(thesis.backbone, ThesisBackbone) and not thesis.classifier.max_pool
+    assert isinstance(thesis.backbone.gru, torch.nn.GRU)
+    assert thesis.backbone.attention is not None
+    assert sum(p.numel() for p in thesis.parameters()) == 80_584  # the thesis model's size
+
+
+@pytest.mark.parametrize("backbone", ["window", "thesis"])
+def test_mlp_encodes_each_node_on_its_own(backbone):
+    model = _build("mlp", backbone=backbone).eval()
     x = torch.randn(2, 8, 12, 9)
     changed = x.clone()
     changed[:, :, 4] += torch.randn(2, 8, 9)
@@ -145,6 +181,8 @@ def test_bad_graph_is_a_clear_error():
 @pytest.mark.parametrize("name", VARIANTS)
 def test_onnx_export_matches_pytorch_with_a_dynamic_batch(name, tmp_path):
     model = _build(name, window=16, severity_head=(name == "anomaly_residual")).eval()
+    with torch.no_grad():  # non-trivial node embeddings, so parity covers them
+        model.backbone.encoder.node.normal_()
     path = tmp_path / f"{name}.onnx"
     names = export_onnx(model, torch.randn(2, 16, 12, 9), path)
     assert names[:2] == ["class_logits", "joint_logits"]

@@ -1,4 +1,9 @@
-"""``CE(graph) + 0.5 BCE(joint head) + 0.1 L_recon`` (+ severity MSE when that head is on)."""
+"""``CE(graph) + w_j L_joint + 0.1 L_recon`` (+ severity MSE when that head is on).
+
+``L_joint`` is, by default, a softmax cross-entropy over the joints on faulted windows (exactly
+one joint is at fault, so the joints compete); ``joint_softmax=False`` gives the thesis's
+per-joint BCE with all-zero targets on healthy windows.
+"""
 
 from __future__ import annotations
 
@@ -14,14 +19,22 @@ def training_loss(
     joint_weight: float,
     recon_weight: float,
     severity_weight: float,
+    joint_softmax: bool = True,
 ) -> tuple[torch.Tensor, dict]:
     ce = F.cross_entropy(out["class_logits"], batch.fault_class)
-    target = torch.zeros_like(out["joint_logits"])
     faulted = batch.active.nonzero(as_tuple=True)[0]
-    target[faulted, batch.fault_joint[faulted]] = 1.0  # healthy windows: no joint at fault
-    bce = F.binary_cross_entropy_with_logits(out["joint_logits"], target)
-    loss = ce + joint_weight * bce
-    parts = {"ce": ce.detach(), "bce": bce.detach()}
+    if joint_softmax:
+        joint = (
+            F.cross_entropy(out["joint_logits"][faulted], batch.fault_joint[faulted])
+            if len(faulted)
+            else out["joint_logits"].sum() * 0.0
+        )
+    else:
+        target = torch.zeros_like(out["joint_logits"])
+        target[faulted, batch.fault_joint[faulted]] = 1.0  # healthy windows: no joint at fault
+        joint = F.binary_cross_entropy_with_logits(out["joint_logits"], target)
+    loss = ce + joint_weight * joint
+    parts = {"ce": ce.detach(), "joint": joint.detach()}
     if "recon_energy" in out:
         healthy = ~batch.active
         recon = (

@@ -9,6 +9,7 @@ import glob
 import math
 import random
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -81,16 +82,34 @@ def coupling_report(model: torch.nn.Module, graph: GraphSpec) -> dict[str, Any]:
     return out
 
 
-def train_run(cfg: DictConfig, out_dir: Path) -> dict[str, Any]:
-    """Train one variant; write ``best.ckpt``, ``train_summary.json`` and TensorBoard logs."""
-    from torch.utils.tensorboard import SummaryWriter
+def validation_score(metrics: dict[str, Any]) -> float:
+    """What checkpoint selection and early stopping maximise: the mean of validation accuracy
+    and localisation accuracy (both are what a user is promised)."""
+    acc = metrics.get("accuracy", float("nan"))
+    loc = metrics.get("localisation_accuracy", float("nan"))
+    return float(np.nanmean([acc, loc]))
 
-    out_dir.mkdir(parents=True, exist_ok=True)
+
+@dataclass
+class Prepared:
+    """Everything a fitting path needs: data, split, normalisation and the built model."""
+
+    cfg: DictConfig
+    graph: GraphSpec
+    rec: Any
+    splits: dict[str, Any]
+    mean: np.ndarray
+    std: np.ndarray
+    tensors: WindowTensors
+    model: torch.nn.Module
+    device: torch.device
+
+
+def prepare(cfg: DictConfig) -> Prepared:
     seed_everything(int(cfg.seed))
     if cfg.trainer.get("threads"):
         torch.set_num_threads(int(cfg.trainer.threads))
     device = pick_device(cfg.trainer.device)
-    t = cfg.trainer
     graph: GraphSpec = instantiate(cfg.graph)
     rec = load_recordings(expand_paths(cfg.data.train))
     x = graph.transform(rec.x)
@@ -101,28 +120,75 @@ def train_run(cfg: DictConfig, out_dir: Path) -> dict[str, Any]:
     model = build_model(
         cfg.model, graph.adjacency, graph.num_joints, schema.N_FEATURES, int(cfg.window)
     ).to(device)
-    optimiser = torch.optim.Adam(model.parameters(), lr=t.lr, weight_decay=t.weight_decay)
-    writer = SummaryWriter(str(out_dir / "tensorboard"))
+    return Prepared(cfg, graph, rec, splits, mean, std, tensors, model, device)
 
-    def loss_fn(out, batch):
-        return training_loss(
-            out, batch, t.joint_loss_weight, t.recon_loss_weight, t.severity_loss_weight
-        )
 
-    generator = torch.Generator().manual_seed(int(cfg.seed))
-    train_windows = splits["train"]
+def _save(p: Prepared, out_dir: Path, best_epoch: int, gamma: float | None) -> None:
+    cfg = p.cfg
+    save_checkpoint(
+        out_dir / CHECKPOINT,
+        p.model,
+        model_cfg=OmegaConf.to_container(cfg.model, resolve=True),
+        variant=str(cfg.variant),
+        graph=p.graph,
+        window=int(cfg.window),
+        mean=p.mean,
+        std=p.std,
+        config=OmegaConf.to_container(cfg, resolve=True),
+        code_version=code_version(),
+        data_fingerprint=p.rec.fingerprint(),
+        best_epoch=best_epoch,
+        extra={"gamma": gamma, "split_runs": split_runs(p)},
+    )
+
+
+def split_runs(p: Prepared) -> dict[str, list[str]]:
+    return {k: sorted({p.rec.run_ids[r] for r in p.rec.run[w.end]}) for k, w in p.splits.items()}
+
+
+def _gamma(model: torch.nn.Module) -> float | None:
+    adjacency = getattr(model, "adjacency", None)
+    gamma = adjacency.gamma() if adjacency is not None else None
+    return None if gamma is None else float(gamma)
+
+
+def fit_gradient(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
+    """Mini-batch training with a learning-rate schedule; keeps the checkpoint of the best
+    validation score and stops after ``patience`` epochs without improvement."""
+    cfg, t, model = p.cfg, p.cfg.trainer, p.model
+    optimiser = instantiate(t.optimizer, params=model.parameters())
+    train_windows = p.splits["train"]
     per_epoch = (
         len(train_windows)
         if t.max_windows_per_epoch is None
         else min(len(train_windows), int(t.max_windows_per_epoch))
     )
-    best_loss, best_epoch, history = math.inf, -1, []
+    batch_size = int(t.batch_size)
+    steps = math.ceil(per_epoch / batch_size)
+    scheduler = (
+        instantiate(t.scheduler)(optimiser, total_steps=steps * int(t.epochs))
+        if t.get("scheduler")
+        else None
+    )
+
+    def loss_fn(out, batch):
+        return training_loss(
+            out,
+            batch,
+            t.joint_loss_weight,
+            t.recon_loss_weight,
+            t.severity_loss_weight,
+            joint_softmax=bool(t.joint_softmax),
+        )
+
+    generator = torch.Generator().manual_seed(int(cfg.seed))
+    best_score, best_epoch, history, stale = -math.inf, -1, [], 0
     started = time.perf_counter()
     for epoch in range(1, int(t.epochs) + 1):
         model.train()
         order = torch.randperm(len(train_windows), generator=generator)[:per_epoch].numpy()
         bar = tqdm(
-            range(0, per_epoch, int(t.batch_size)),
+            range(0, per_epoch, batch_size),
             desc=f"epoch {epoch}/{t.epochs}",
             leave=False,
             disable=not t.progress,
@@ -130,85 +196,125 @@ def train_run(cfg: DictConfig, out_dir: Path) -> dict[str, Any]:
         )
         running = 0.0
         for step, i in enumerate(bar, start=1):
-            batch = tensors.batch(train_windows, order[i : i + int(t.batch_size)])
+            batch = p.tensors.batch(train_windows, order[i : i + batch_size])
             loss, _ = loss_fn(model(batch.x), batch)
             optimiser.zero_grad(set_to_none=True)
             loss.backward()
             optimiser.step()
+            if scheduler is not None:
+                scheduler.step()
             running += loss.item()
             if step % 10 == 0:
                 bar.set_postfix(loss=f"{running / step:.4f}")
-        val = predict(model, tensors, splits["val"], loss_fn=loss_fn)
+        val = predict(model, p.tensors, p.splits["val"], loss_fn=loss_fn)
         val_m = metrics_of(val)
         row = {
             "epoch": epoch,
+            "seconds": time.perf_counter() - started,
+            "lr": optimiser.param_groups[0]["lr"],
             "train_loss": running / max(step, 1),
             "val_loss": val.loss,
             "val_accuracy": val_m.get("accuracy"),
             "val_localisation": val_m.get("localisation_accuracy"),
             "val_macro_f1": val_m.get("macro_f1"),
+            "val_score": validation_score(val_m),
         }
-        gamma = (
-            getattr(model.adjacency, "gamma", lambda: None)()
-            if hasattr(model, "adjacency")
-            else None
-        )
-        if gamma is not None:
-            row["gamma"] = float(gamma)
+        if _gamma(model) is not None:
+            row["gamma"] = _gamma(model)
         history.append(row)
         for key, value in row.items():
             if key != "epoch" and value is not None:
                 writer.add_scalar(key, value, epoch)
+        improved = row["val_score"] > best_score
         if t.progress:
             tqdm.write(
                 f"epoch {epoch:>3}: loss {row['train_loss']:.4f}  val loss {val.loss:.4f}  "
                 f"acc {row['val_accuracy']:.3f}  loc {row['val_localisation']:.3f}"
+                f"{'  *' if improved else ''}  ({row['seconds']:.0f} s)"
             )
-        if val.loss < best_loss:
-            best_loss, best_epoch = val.loss, epoch
-            save_checkpoint(
-                out_dir / CHECKPOINT,
-                model,
-                model_cfg=OmegaConf.to_container(cfg.model, resolve=True),
-                variant=str(cfg.variant),
-                graph=graph,
-                window=int(cfg.window),
-                mean=mean,
-                std=std,
-                config=OmegaConf.to_container(cfg, resolve=True),
-                code_version=code_version(),
-                data_fingerprint=rec.fingerprint(),
-                best_epoch=best_epoch,
-                extra={
-                    "gamma": row.get("gamma"),
-                    "split_runs": {
-                        k: sorted({rec.run_ids[r] for r in rec.run[w.end]})
-                        for k, w in splits.items()
-                    },
-                },
-            )
-    writer.close()
+        if improved:
+            best_score, best_epoch, stale = row["val_score"], epoch, 0
+            _save(p, out_dir, best_epoch, row.get("gamma"))
+        else:
+            stale += 1
+            if t.patience is not None and stale >= int(t.patience):
+                break
+    return best_epoch, history
+
+
+def fit_trees(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
+    """Models fitted in one call (``model.fit``), e.g. the gradient-boosted trees."""
+    started = time.perf_counter()
+
+    def table(windows):
+        feats, cls, joint = [], [], []
+        for i in range(0, len(windows), 4096):
+            batch = p.tensors.batch(windows, np.arange(i, min(i + 4096, len(windows))))
+            feats.append(p.model.features(batch.x))
+            cls.append(batch.fault_class.cpu().numpy())
+            joint.append(batch.fault_joint.cpu().numpy())
+        return np.concatenate(feats), np.concatenate(cls), np.concatenate(joint)
+
+    record = p.model.fit(
+        table(p.splits["train"]),
+        table(p.splits["val"]),
+        seed=int(p.cfg.seed),
+        threads=p.cfg.trainer.get("threads"),
+    )
+    val_m = metrics_of(predict(p.model, p.tensors, p.splits["val"]))
+    row = {
+        "epoch": 1,
+        "seconds": time.perf_counter() - started,
+        "val_accuracy": val_m.get("accuracy"),
+        "val_localisation": val_m.get("localisation_accuracy"),
+        "val_macro_f1": val_m.get("macro_f1"),
+        "val_score": validation_score(val_m),
+        "boosting": record,
+    }
+    for key in ("val_accuracy", "val_localisation", "val_macro_f1", "val_score"):
+        writer.add_scalar(key, row[key], 1)
+    if p.cfg.trainer.progress:
+        tqdm.write(
+            f"trees: {record['class']['best_iteration']} + {record['joint']['best_iteration']} "
+            f"rounds  val acc {row['val_accuracy']:.3f}  loc {row['val_localisation']:.3f}  "
+            f"({row['seconds']:.0f} s)"
+        )
+    _save(p, out_dir, 1, None)
+    return 1, [row]
+
+
+def train_run(cfg: DictConfig, out_dir: Path) -> dict[str, Any]:
+    """Train one variant; write ``best.ckpt``, ``train_summary.json`` and TensorBoard logs."""
+    from torch.utils.tensorboard import SummaryWriter
+
     from robohealth_mj.learn.checkpoint import load_checkpoint, model_from_checkpoint
 
-    best = model_from_checkpoint(load_checkpoint(out_dir / CHECKPOINT)).to(device)
-    test_m = metrics_of(predict(best, tensors, splits["test"]))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    started = time.perf_counter()
+    p = prepare(cfg)
+    writer = SummaryWriter(str(out_dir / "tensorboard"))
+    fit = fit_trees if callable(getattr(p.model, "fit", None)) else fit_gradient
+    best_epoch, history = fit(p, out_dir, writer)
+    writer.close()
+    best = model_from_checkpoint(load_checkpoint(out_dir / CHECKPOINT)).to(p.device)
+    test_m = metrics_of(predict(best, p.tensors, p.splits["test"]))
     summary = {
         "variant": str(cfg.variant),
         "window": int(cfg.window),
         "seed": int(cfg.seed),
-        "graph": graph.name,
+        "graph": p.graph.name,
         "best_epoch": best_epoch,
-        "epochs": int(t.epochs),
+        "epochs": len(history),
         "gamma": history[best_epoch - 1].get("gamma"),
-        "train_seconds": time.perf_counter() - started,
-        "windows": {k: len(v) for k, v in splits.items()},
-        "split_runs": {
-            k: sorted({rec.run_ids[r] for r in rec.run[w.end]}) for k, w in splits.items()
-        },
-        "data_fingerprint": rec.fingerprint(),
+        "train_seconds": history[-1]["seconds"],
+        "seconds_to_best": history[best_epoch - 1]["seconds"],
+        "wall_seconds": time.perf_counter() - started,
+        "windows": {k: len(v) for k, v in p.splits.items()},
+        "split_runs": split_runs(p),
+        "data_fingerprint": p.rec.fingerprint(),
         "history": history,
         "test": test_m,
-        **coupling_report(best, graph),
+        **coupling_report(best, p.graph),
     }
     atomic_write_json(out_dir / "train_summary.json", summary)
     return summary

@@ -1,4 +1,5 @@
-"""Spatio-temporal GNN variants (thesis §2.4, Table 3), built from ``conf/model/<name>.yaml``.
+"""Spatio-temporal GNN variants (thesis §2.4, Table 3) and the ``gbdt`` baseline, built from
+``conf/model/<name>.yaml`` (plus ``conf/backbone/<name>.yaml`` for the networks).
 
 Every model takes a normalised window ``x: [B, W, N, F]`` (N = J joints then M sensors) and returns
 a dict with ``class_logits [B, 7]``, ``joint_logits [B, J]`` and, where present,
@@ -7,8 +8,8 @@ a dict with ``class_logits [B, 7]``, ``joint_logits [B, J]`` and, where present,
 
 from robohealth_mj.models.build import build_model
 
-# The nine variants in the thesis's Table 3 order (each has conf/model/<name>.yaml).
-VARIANTS: tuple[str, ...] = (
+# The nine networks in the thesis's Table 3 order (each has conf/model/<name>.yaml).
+NETWORK_VARIANTS: tuple[str, ...] = (
     "mlp",
     "gat",
     "stgnn_fixed",
@@ -19,5 +20,7 @@ VARIANTS: tuple[str, ...] = (
     "anomaly_residual",
     "pose_anomaly",
 )
+# Every variant, the classical baseline first: it is the bar each table compares against.
+VARIANTS: tuple[str, ...] = ("gbdt", *NETWORK_VARIANTS)
 
-__all__ = ["VARIANTS", "build_model"]
+__all__ = ["NETWORK_VARIANTS", "VARIANTS", "build_model"]

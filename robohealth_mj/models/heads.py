@@ -15,17 +15,30 @@ def mlp(in_dim: int, hidden: int, out_dim: int, dropout: float = 0.0) -> nn.Sequ
 
 
 class GraphClassifier(nn.Module):
-    """Mean-pooled node embeddings (+ an MLP of the last joint positions for pose variants)."""
+    """Mean-pooled (and, with ``max_pool``, max-pooled) node embeddings, + an MLP of the last
+    joint positions for pose variants. The max keeps one sensor's strong evidence from being
+    averaged away over twelve nodes."""
 
-    def __init__(self, hidden: int, num_classes: int, dropout: float, pose_joints: int = 0) -> None:
+    def __init__(
+        self,
+        hidden: int,
+        num_classes: int,
+        dropout: float,
+        pose_joints: int = 0,
+        max_pool: bool = False,
+    ) -> None:
         super().__init__()
+        self.max_pool = max_pool
         self.pose = mlp(pose_joints, hidden, hidden) if pose_joints else None
-        self.out = mlp(hidden * (2 if pose_joints else 1), hidden, num_classes, dropout)
+        width = hidden * (1 + int(max_pool) + int(bool(pose_joints)))
+        self.out = mlp(width, hidden, num_classes, dropout)
 
     def forward(
         self, nodes: torch.Tensor, joint_positions: torch.Tensor | None = None
     ) -> torch.Tensor:
         pooled = nodes.mean(dim=1)
+        if self.max_pool:
+            pooled = torch.cat([pooled, nodes.amax(dim=1)], dim=-1)
         if self.pose is not None:
             pooled = torch.cat([pooled, self.pose(joint_positions)], dim=-1)
         return self.out(pooled)
@@ -50,8 +63,8 @@ class AnomalyResidualHead(nn.Module):
 
     ``C_pred`` (columns sum to 1 over joints) predicts each sensor embedding from its coupled
     joints; the residual ``r_m = s_m - f(sum_j C_pred_jm h_j)`` is scored by ``g`` and scattered
-    back through ``C_scat`` (rows sum to 1 over sensors) to joint logits, and ``||r_m||^2`` to a
-    per-joint reconstruction energy for the healthy-data penalty. Works for any M.
+    back through ``C_scat`` (rows sum to 1 over sensors) to joint logits, and ``||r_m||^2 / H`` to
+    a per-joint reconstruction energy for the healthy-data penalty. Works for any M.
     """
 
     def __init__(
@@ -83,7 +96,7 @@ class AnomalyResidualHead(nn.Module):
         residual = s - predicted
         scores = self.g(residual).squeeze(-1)  # [B, M]
         logits = scores @ c_scat.transpose(0, 1)  # [B, J]
-        energy = residual.square().sum(-1) @ c_scat.transpose(0, 1)  # [B, J]
+        energy = residual.square().mean(-1) @ c_scat.transpose(0, 1)  # [B, J], per channel
         return logits, energy
 
 

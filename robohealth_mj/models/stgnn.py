@@ -1,5 +1,12 @@
-"""The ST-GNN family: fixed, pose-gated, learned-residual and anomaly-residual variants share one
-class whose switches add the mechanisms of Table 3 (no registry: the config says which)."""
+"""The graph-model family of Table 3. One class whose switches add each variant's mechanism (pose
+kernel, learned residual, spectral features, coupling head, graph attention, no cross-node path
+at all); the config says which, so there is no registry. The spatio-temporal backbone is its own
+config group (``backbone=window`` by default, ``backbone=thesis`` for the thesis's GCN + GRU).
+
+Shapes: ``x [B, W, N, F]`` (J joints, then M sensors) -> ``class_logits [B, C]``,
+``joint_logits [B, J]`` and, where present, ``recon_energy [B, J]``, ``gamma []``,
+``severity [B]``.
+"""
 
 from __future__ import annotations
 
@@ -7,7 +14,7 @@ import torch
 from torch import nn
 
 from robohealth_mj.models.adjacency import AdjacencyBuilder
-from robohealth_mj.models.backbone import STBackbone
+from robohealth_mj.models.backbone import GraphConvFactory, WindowBackbone
 from robohealth_mj.models.heads import (
     AnomalyResidualHead,
     GraphClassifier,
@@ -30,6 +37,10 @@ class STGNN(nn.Module):
         hidden: int = 64,
         dropout: float = 0.1,
         heads: int = 4,
+        backbone: GraphConvFactory | None = None,
+        graph_conv: GraphConvFactory | None = None,
+        attention: bool | None = None,
+        max_pool: bool = True,
         pose_kernel: bool = False,
         learned_residual: bool = False,
         spectral_features: bool = False,
@@ -43,10 +54,24 @@ class STGNN(nn.Module):
         self.adjacency = AdjacencyBuilder(adjacency, pose_kernel, learned_residual)
         self.spectral = SpectralFeatures(window) if spectral_features else None
         extra = NUM_SPECTRAL if spectral_features else 0
-        self.embed = nn.Linear(in_features + extra, hidden)
-        self.backbone = STBackbone(hidden, dropout, heads)
+        make_backbone = backbone or WindowBackbone
+        options = {} if attention is None else {"attention": attention}  # None: the backbone's
+        self.backbone = make_backbone(
+            in_features=in_features + extra,
+            num_nodes=n,
+            window=window,
+            hidden=hidden,
+            dropout=dropout,
+            graph_conv=graph_conv,
+            heads=heads,
+            **options,
+        )
         self.classifier = GraphClassifier(
-            hidden, num_classes, dropout, pose_joints=num_joints if pose_kernel else 0
+            hidden,
+            num_classes,
+            dropout,
+            pose_joints=num_joints if pose_kernel else 0,
+            max_pool=max_pool,
         )
         self.anomaly = (
             AnomalyResidualHead(hidden, num_joints, n - num_joints) if anomaly_head else None
@@ -54,14 +79,21 @@ class STGNN(nn.Module):
         self.localise = None if anomaly_head else NodeLocalisationHead(hidden, num_joints, dropout)
         self.severity = SeverityHead(hidden, dropout) if severity_head else None
 
-    def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:
+    def node_embeddings(self, x: torch.Tensor) -> torch.Tensor:
+        """Refined per-node embeddings ``[B, N, H]`` (what the heads read)."""
+        return self._features(x)[1][0]
+
+    def _features(self, x: torch.Tensor):
         positions = x[:, -1, :, self.pos_index]  # [B, N], standardised
         adj = self.adjacency(positions)
         features = x
         if self.spectral is not None:
             spec = self.spectral(x).unsqueeze(1).expand(-1, x.shape[1], -1, -1)
             features = torch.cat([x, spec], dim=-1)
-        refined, temporal, skip = self.backbone(self.embed(features), adj)
+        return positions, self.backbone(features, adj)
+
+    def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:
+        positions, (refined, temporal, skip) = self._features(x)
         out = {"class_logits": self.classifier(refined, positions[:, : self.num_joints])}
         if self.anomaly is not None:
             out["joint_logits"], out["recon_energy"] = self.anomaly(temporal)

@@ -88,6 +88,11 @@ def export_checkpoint(
     """Write ``out`` (ONNX) and verify it against PyTorch on real held-out windows."""
     ckpt = load_checkpoint(ckpt_path)
     model = model_from_checkpoint(ckpt)
+    if callable(getattr(model, "fit", None)):
+        raise ValueError(
+            f"{ckpt_path}: variant {ckpt['variant']!r} is a tree ensemble, which has no ONNX "
+            "export here; export a network variant"
+        )
     graph = graph_from_checkpoint(ckpt)
     pre = RawInput(ckpt["norm_mean"], ckpt["norm_std"], graph.coupling).eval()
     windows = heldout_windows(ckpt, data, parity_windows)

@@ -1,0 +1,32 @@
+"""Draws ablation.png from ablation.csv (the models issue's ablation table).
+
+    python results/ablation_models/figure.py
+"""
+
+import csv
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+here = Path(__file__).parent
+rows = list(csv.DictReader((here / "ablation.csv").open()))
+labels = [r["change"] for r in rows]
+acc = [float(r["accuracy"]) for r in rows]
+loc = [float(r["localisation"]) for r in rows]
+secs = [float(r["train_s"]) for r in rows]
+fig, (a, b) = plt.subplots(1, 2, figsize=(12, 0.45 * len(rows) + 1.5), sharey=True)
+y = range(len(rows))
+a.barh([i + 0.2 for i in y], acc, 0.4, label="accuracy")
+a.barh([i - 0.2 for i in y], loc, 0.4, label="localisation")
+a.set_xlim(0.75, 0.95)
+a.set_yticks(list(y), labels)
+a.invert_yaxis()
+a.set_xlabel("held-out (standard corpus, seed 900), W = 32, seed 42")
+a.legend(loc="lower right")
+b.barh(list(y), secs, color="grey")
+b.set_xlabel("training seconds (one thread, two runs sharing 2 cores)")
+fig.tight_layout()
+fig.savefig(here / "ablation.png", dpi=120)

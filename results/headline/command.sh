@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# The models issue's campaign on the standard corpus (W = 32, seeds 42-44), two jobs of one thread
+# each, then the report. Run from the repository root after `python -m robohealth_mj.corpus`.
+set -euo pipefail
+PY=${PY:-.venv/bin/python}
+$PY -m robohealth_mj.train -m +experiment=headline hydra/launcher=local trainer.threads=1
+$PY -m robohealth_mj.train -m +experiment=headline hydra/launcher=local trainer.threads=1 \
+  graph=harness variant=gbdt,stgnn_fixed,anomaly_residual
+$PY -m robohealth_mj.report outputs/campaign_headline
