@@ -1,6 +1,6 @@
 """Draws ablation.png from ablation.csv (the models issue's ablation table).
 
-    python results/ablation_models/figure.py
+python results/ablation_models/figure.py
 """
 
 import csv
@@ -9,7 +9,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 here = Path(__file__).parent
 rows = list(csv.DictReader((here / "ablation.csv").open()))
@@ -21,12 +21,12 @@ fig, (a, b) = plt.subplots(1, 2, figsize=(12, 0.45 * len(rows) + 1.5), sharey=Tr
 y = range(len(rows))
 a.barh([i + 0.2 for i in y], acc, 0.4, label="accuracy")
 a.barh([i - 0.2 for i in y], loc, 0.4, label="localisation")
-a.set_xlim(0.75, 0.95)
+a.set_xlim(0.70, 0.95)
 a.set_yticks(list(y), labels)
 a.invert_yaxis()
 a.set_xlabel("held-out (standard corpus, seed 900), W = 32, seed 42")
-a.legend(loc="lower right")
+a.legend(loc="lower left")
 b.barh(list(y), secs, color="grey")
-b.set_xlabel("training seconds (one thread, two runs sharing 2 cores)")
+b.set_xlabel("training seconds (one thread; 2-4 runs shared the 2 cores)")
 fig.tight_layout()
 fig.savefig(here / "ablation.png", dpi=120)

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# A CPU-sized slice of the campaign on the standard corpus (no GPU lent to this task).
+# A CPU-sized slice of the campaign on the standard corpus (no GPU lent to this task), made with
+# the thesis backbone and recipe of commit eed42d5 (before the window backbone); run it there.
 cd "$(dirname "$0")/../.." && . .venv/bin/activate
 python -c "
 from robohealth_mj.data.arrays import load_recordings

@@ -101,8 +101,10 @@ def export_checkpoint(
     tmp = out.with_name(f".{out.name}.tmp")
     outputs = export_onnx(model, windows[:2], tmp, pre=pre)
     error = onnx_parity(model, tmp, windows, pre=pre)
+    side_data = tmp.with_name(tmp.name + ".data")  # the exporter's external weights, if any
     if not error <= PARITY_TOLERANCE:
         tmp.unlink(missing_ok=True)
+        side_data.unlink(missing_ok=True)
         raise RuntimeError(
             f"ONNX parity check failed: max |torch - onnxruntime| = {error:.3g} "
             f"> {PARITY_TOLERANCE} on {len(windows)} held-out windows"
@@ -121,7 +123,8 @@ def export_checkpoint(
         code_version=ckpt["code_version"],
         parity_max_abs_error=f"{error:.3g}",
     )
-    attach_metadata(tmp, out, metadata)
+    attach_metadata(tmp, out, metadata)  # writes one self-contained file
+    side_data.unlink(missing_ok=True)
     return {
         "path": str(out),
         "parity_max_abs_error": error,
