@@ -4,7 +4,7 @@
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
 $PY -m robohealth_mj.train -m +experiment=headline hydra/launcher=local trainer.threads=1
-# Harness rows: seed 42 only (the session's CPU time did not stretch to three seeds).
+# Harness rows over the three seeds.
 $PY -m robohealth_mj.train -m +experiment=headline hydra/launcher=local trainer.threads=1 \
-  graph=harness variant=gbdt,stgnn_fixed,anomaly_residual seed=42
+  graph=harness variant=gbdt,stgnn_fixed,anomaly_residual seed=42,43,44
 $PY -m robohealth_mj.report outputs/campaign_headline
