@@ -13,6 +13,9 @@ STAMP  := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 setup: $(STAMP)
 
 $(STAMP): pyproject.toml
+	@# LightGBM's wheel links the system's OpenMP runtime (libgomp1); install it where missing.
+	@ldconfig -p | grep -q libgomp.so.1 || (apt-get update -qq && apt-get install -y -qq libgomp1) \
+		|| echo "warning: libgomp1 is missing and could not be installed; the gbdt variant needs it"
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	# CPU build of torch first (a local file on these machines), so nothing pulls a CUDA build.
