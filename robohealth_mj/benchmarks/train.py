@@ -20,7 +20,7 @@ def bench_train(
     from robohealth_mj.data.arrays import load_recordings
     from robohealth_mj.data.windows import make_windows, normalisation
     from robohealth_mj.learn.data import WindowTensors
-    from robohealth_mj.learn.loss import training_loss
+    from robohealth_mj.learn.loss import loss_from_config
     from robohealth_mj.learn.trainer import expand_paths
 
     t0 = time.perf_counter()
@@ -30,7 +30,7 @@ def bench_train(
     mean, std = normalisation(rec.x, windows)
     tensors = WindowTensors(rec.x, rec, mean, std, torch.device("cpu"))
     peak = matmul_rate()
-    weights = compose_config("train").trainer
+    loss_fn = loss_from_config(compose_config("train").trainer)
     print(
         f"data: {len(rec)} samples, {len(windows)} windows; loading from the binary cache "
         f"{load_s:.2f} s; matmul rate {peak / 1e9:.0f} GFLOP/s; batch {batch}, W={window}"
@@ -43,14 +43,7 @@ def bench_train(
         opt = torch.optim.AdamW(model.parameters(), lr=1e-3)
 
         def step(b, model=model, opt=opt):
-            loss, _ = training_loss(
-                model(b.x),
-                b,
-                weights.joint_loss_weight,
-                weights.recon_loss_weight,
-                weights.severity_loss_weight,
-                joint_softmax=bool(weights.joint_softmax),
-            )
+            loss, _ = loss_fn(model(b.x), b)
             opt.zero_grad(set_to_none=True)
             loss.backward()
             opt.step()

@@ -19,7 +19,13 @@ from robohealth_mj.learn.checkpoint import (
 from robohealth_mj.learn.data import WindowTensors
 from robohealth_mj.learn.metrics import flat_rows
 from robohealth_mj.learn.predict import predict
-from robohealth_mj.learn.trainer import coupling_report, expand_paths, metrics_of, pick_device
+from robohealth_mj.learn.trainer import (
+    coupling_report,
+    expand_paths,
+    gamma_of,
+    metrics_of,
+    pick_device,
+)
 
 
 def evaluate_checkpoint(
@@ -39,7 +45,6 @@ def evaluate_checkpoint(
     model = model_from_checkpoint(ckpt).to(dev)
     windows = make_windows(rec, int(ckpt["window"]), ckpt["config"].get("stride"))
     metrics = metrics_of(predict(model, tensors, windows))
-    gamma = model.adjacency.gamma() if hasattr(model, "adjacency") else None
     return {
         "checkpoint": str(ckpt_path),
         "variant": ckpt["variant"],
@@ -48,7 +53,7 @@ def evaluate_checkpoint(
         "data": [str(f) for f in files],
         "data_fingerprint": rec.fingerprint(),
         "best_epoch": ckpt["best_epoch"],
-        "gamma": None if gamma is None else float(gamma),
+        "gamma": gamma_of(model),
         **coupling_report(model, graph),
         "metrics": metrics,
     }

@@ -7,6 +7,9 @@ per-joint BCE with all-zero targets on healthy windows.
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
+
 import torch
 import torch.nn.functional as F
 
@@ -49,3 +52,15 @@ def training_loss(
         loss = loss + severity_weight * sev
         parts["severity"] = sev.detach()
     return loss, parts
+
+
+def loss_from_config(trainer_cfg) -> Callable[[dict[str, torch.Tensor], WindowBatch], tuple]:
+    """``training_loss`` with the weights and options of a ``trainer`` config."""
+    t = trainer_cfg
+    return functools.partial(
+        training_loss,
+        joint_weight=float(t.joint_loss_weight),
+        recon_weight=float(t.recon_loss_weight),
+        severity_weight=float(t.severity_loss_weight),
+        joint_softmax=bool(t.joint_softmax),
+    )

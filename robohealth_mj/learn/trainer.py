@@ -26,7 +26,7 @@ from robohealth_mj.data.graphs import GraphSpec, coupling_correlation
 from robohealth_mj.data.windows import make_windows, normalisation, run_aware_split
 from robohealth_mj.learn.checkpoint import save_checkpoint
 from robohealth_mj.learn.data import WindowTensors
-from robohealth_mj.learn.loss import training_loss
+from robohealth_mj.learn.loss import loss_from_config
 from robohealth_mj.learn.metrics import compute_metrics
 from robohealth_mj.learn.predict import Predictions, predict
 from robohealth_mj.models import build_model
@@ -146,7 +146,8 @@ def split_runs(p: Prepared) -> dict[str, list[str]]:
     return {k: sorted({p.rec.run_ids[r] for r in p.rec.run[w.end]}) for k, w in p.splits.items()}
 
 
-def _gamma(model: torch.nn.Module) -> float | None:
+def gamma_of(model: torch.nn.Module) -> float | None:
+    """|γ| of a pose-kernel model, else None."""
     adjacency = getattr(model, "adjacency", None)
     gamma = adjacency.gamma() if adjacency is not None else None
     return None if gamma is None else float(gamma)
@@ -171,16 +172,7 @@ def fit_gradient(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
         else None
     )
 
-    def loss_fn(out, batch):
-        return training_loss(
-            out,
-            batch,
-            t.joint_loss_weight,
-            t.recon_loss_weight,
-            t.severity_loss_weight,
-            joint_softmax=bool(t.joint_softmax),
-        )
-
+    loss_fn = loss_from_config(t)
     generator = torch.Generator().manual_seed(int(cfg.seed))
     best_score, best_epoch, history, stale = -math.inf, -1, [], 0
     started = time.perf_counter()
@@ -219,8 +211,9 @@ def fit_gradient(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
             "val_macro_f1": val_m.get("macro_f1"),
             "val_score": validation_score(val_m),
         }
-        if _gamma(model) is not None:
-            row["gamma"] = _gamma(model)
+        gamma = gamma_of(model)
+        if gamma is not None:
+            row["gamma"] = gamma
         history.append(row)
         for key, value in row.items():
             if key != "epoch" and value is not None:

@@ -160,7 +160,7 @@ class WindowEncoder(nn.Module):
         b, w, n, f = x.shape
         views = []
         if self.snapshot is not None:
-            step = torch.cat([x[:, :1] * 0.0, x[:, 1:] - x[:, :-1]], dim=1)
+            step = torch.cat([torch.zeros_like(x[:, :1]), x[:, 1:] - x[:, :-1]], dim=1)
             views.append(self._pool(self.snapshot(torch.cat([x, step], dim=-1)), 1))
         if self.conv is not None:
             seq = self.conv(x.permute(0, 2, 3, 1).reshape(b * n, f, w))  # [B*N, C, W]
