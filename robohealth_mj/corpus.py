@@ -9,7 +9,12 @@ Sessions run in parallel (one process per core by default). A finished session (
 
     python -m robohealth_mj.corpus                      # standard corpus
     python -m robohealth_mj.corpus corpus=quick         # small corpus for the main job and tests
-    python -m robohealth_mj.corpus corpus=quick 'record_overrides=[faults.fault_model=physics]'
+    python -m robohealth_mj.corpus corpus=quick fault_model=hybrid   # + the thesis's signatures
+    python -m robohealth_mj.corpus 'record_overrides=["faults.ramp_s=1.0"]'   # any record override
+
+A list element that holds ``=`` must be quoted for Hydra's grammar, as above. A session on disk is
+reused only when its manifest is complete, of this schema version and of the same run id (the
+same config), so changing the fault model or any override re-records it.
 """
 
 from __future__ import annotations
@@ -27,7 +32,8 @@ from tqdm import tqdm
 
 from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.config import compose_config
-from robohealth_mj.recorder import GRAPHS_FILE, MANIFEST_FILE, record_session
+from robohealth_mj.recorder import GRAPHS_FILE, MANIFEST_FILE, default_run_id, record_session
+from robohealth_mj.schema import SCHEMA_VERSION
 from robohealth_mj.version import code_version
 
 CORPUS_INDEX = "corpus.json"
@@ -90,18 +96,27 @@ def _length(length: dict[str, Any]) -> list[str]:
     return [f"session.duration_s={length['duration_s']}"]
 
 
+def _session_config(spec: SessionSpec) -> DictConfig:
+    return compose_config("record", ["session.progress=false", *spec.overrides])
+
+
 def _record_one(spec: SessionSpec, out_dir: str) -> dict[str, Any]:
-    cfg = compose_config("record", ["session.progress=false", *spec.overrides])
-    result = record_session(cfg, out_dir)
+    result = record_session(_session_config(spec), out_dir)
     return {"status": result.manifest["status"], "samples": result.manifest["sample_count"]}
 
 
-def _is_complete(session_dir: Path) -> bool:
+def _is_complete(session_dir: Path, spec: SessionSpec) -> bool:
+    """A finished recording of exactly this session (schema version and run id agree)."""
     try:
         manifest = json.loads((session_dir / MANIFEST_FILE).read_text())
     except (OSError, json.JSONDecodeError):
         return False
-    return manifest.get("status") == "complete" and (session_dir / GRAPHS_FILE).is_file()
+    return (
+        manifest.get("status") == "complete"
+        and manifest.get("schema_version") == SCHEMA_VERSION
+        and manifest.get("recording_run_id") == default_run_id(_session_config(spec))
+        and (session_dir / GRAPHS_FILE).is_file()
+    )
 
 
 def build_corpus(
@@ -109,7 +124,7 @@ def build_corpus(
 ) -> dict[str, Any]:
     out_dir.mkdir(parents=True, exist_ok=True)
     specs = plan(corpus, extra)
-    todo = [s for s in specs if not _is_complete(out_dir / s.name)]
+    todo = [s for s in specs if not _is_complete(out_dir / s.name, s)]
     bar = tqdm(
         total=len(specs),
         initial=len(specs) - len(todo),
@@ -149,7 +164,8 @@ def build_corpus(
 def main(cfg: DictConfig) -> None:
     out_dir = Path(cfg.out_dir)
     jobs = cfg.jobs or os.cpu_count() or 1
-    index = build_corpus(cfg.corpus, out_dir, jobs, list(cfg.record_overrides), cfg.progress)
+    extra = [f"faults.fault_model={cfg.fault_model}", *cfg.record_overrides]
+    index = build_corpus(cfg.corpus, out_dir, jobs, extra, cfg.progress)
     for role, sessions in index["roles"].items():
         total = sum(s["samples"] for s in sessions)
         print(f"{role:<20} {len(sessions):>3} session(s) {total:>9} samples")

@@ -23,6 +23,7 @@ from hydra.utils import instantiate
 from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
+from robohealth_mj.arm import ArmSimulator, TickChunk
 from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.data.jsonl import format_line, node_features
 from robohealth_mj.faults.injector import FaultInjector
@@ -34,7 +35,6 @@ from robohealth_mj.schema import (
     SCHEMA_VERSION,
     FaultLabel,
 )
-from robohealth_mj.sim.arm import ArmSimulator, TickChunk
 from robohealth_mj.version import code_version
 
 GRAPHS_FILE = "graphs.jsonl"
@@ -252,19 +252,24 @@ def segment_info(sim: ArmSimulator, chunk: TickChunk) -> dict[str, Any]:
     }
 
 
+def chunk_features(chunk: TickChunk) -> np.ndarray:
+    """Node features ``[n, 12, F]`` of every tick of a chunk, in the schema's channel order."""
+    state = np.stack(
+        [chunk.pos, chunk.vel, chunk.effort, chunk.pos_error, chunk.effort_residual], axis=-1
+    )
+    sensor = np.concatenate(
+        [chunk.vib[..., None], chunk.acc, chunk.bands, chunk.kurtosis[..., None]], axis=-1
+    )
+    return node_features(state, sensor)
+
+
 def chunk_lines(sim: ArmSimulator, chunk: TickChunk, run_id: str) -> list[str]:
     """One GraphSample JSON line per tick of a just-simulated chunk."""
     segment = segment_info(sim, chunk)
     first = sim.tick - len(chunk.t)
+    x = chunk_features(chunk)
     return [
-        format_line(
-            run_id,
-            first + k,
-            float(chunk.t[k]),
-            node_features(chunk.pos[k], chunk.vel[k], chunk.effort[k], chunk.vib[k], chunk.acc[k]),
-            chunk.fault,
-            segment,
-        )
+        format_line(run_id, first + k, float(chunk.t[k]), x[k], chunk.fault, segment)
         for k in range(len(chunk.t))
     ]
 

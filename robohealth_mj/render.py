@@ -41,8 +41,8 @@ def localisation_tint(joint_scores: dict[str, float]) -> np.ndarray:
 def render_episode(cfg: DictConfig) -> list:
     from PIL import Image
 
-    from robohealth_mj.data.jsonl import format_line, node_features
-    from robohealth_mj.recorder import build_simulator
+    from robohealth_mj.data.jsonl import format_line
+    from robohealth_mj.recorder import build_simulator, chunk_features
     from robohealth_mj.runtime.render import EpisodeRenderer, write_video
     from robohealth_mj.runtime.runtime import ModelRuntime
 
@@ -69,7 +69,7 @@ def render_episode(cfg: DictConfig) -> list:
         png_dir.mkdir(parents=True, exist_ok=True)
     segment = {"index": 0, "family": "render", "speed_scale": 1.0, "payload_scale": 1.0}
     for k, chunk in enumerate(sim.run(round(cfg.duration_s / sim.tick_s))):
-        x = node_features(chunk.pos[0], chunk.vel[0], chunk.effort[0], chunk.vib[0], chunk.acc[0])
+        x = chunk_features(chunk)[0]
         d = runtime.process(
             "render", format_line("render", k, float(chunk.t[0]), x, chunk.fault, segment)
         )

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-SCHEMA_VERSION = "1.0"
+SCHEMA_VERSION = "2.0"  # 2.0: tracking error, torque residual, piezo bands, kurtosis
 
 JOINT_NAMES: tuple[str, ...] = (
     "shoulder_pan",
@@ -25,22 +25,35 @@ JOINT_NAMES: tuple[str, ...] = (
 )
 SENSOR_NAMES: tuple[str, ...] = tuple(f"{name}_sensor" for name in JOINT_NAMES)
 NODE_NAMES: tuple[str, ...] = JOINT_NAMES + SENSOR_NAMES
-FEATURE_NAMES: tuple[str, ...] = (
-    "is_joint",
-    "is_sensor",
-    "pos",
-    "vel",
-    "effort",
+# Joint state (on joint nodes and, for its own joint, on each sensor node): what a UR controller
+# reports over RTDE. ``pos_error`` is the measured link angle minus the controller's target;
+# ``effort_residual`` the drive torque minus the controller's model torque (target vs actual
+# current, the signal behind a UR's collision and friction monitoring).
+STATE_FEATURES: tuple[str, ...] = ("pos", "vel", "effort", "pos_error", "effort_residual")
+# The sensor package (sensor nodes only): piezo vibration level, MEMS acceleration, the piezo's
+# energy in three sub-bands and the kurtosis of its signal over the tick (see sim/sensors.py).
+SENSOR_FEATURES: tuple[str, ...] = (
     "vib",
     "acc_x",
     "acc_y",
     "acc_z",
+    "vib_20_80",
+    "vib_80_200",
+    "vib_200_450",
+    "vib_kurtosis",
 )
+FEATURE_NAMES: tuple[str, ...] = ("is_joint", "is_sensor", *STATE_FEATURES, *SENSOR_FEATURES)
 N_JOINTS = len(JOINT_NAMES)
 N_NODES = len(NODE_NAMES)
 N_FEATURES = len(FEATURE_NAMES)
-STATE_CHANNELS = slice(2, 5)  # pos, vel, effort
-SENSOR_CHANNELS = slice(5, 9)  # vib, acc_x, acc_y, acc_z
+STATE_CHANNELS = slice(2, 2 + len(STATE_FEATURES))
+SENSOR_CHANNELS = slice(STATE_CHANNELS.stop, N_FEATURES)
+
+
+def feature_index(name: str) -> int:
+    """Column of a named feature in ``x``."""
+    return FEATURE_NAMES.index(name)
+
 
 FAULT_CLASSES: tuple[str, ...] = (
     "none",
@@ -166,13 +179,15 @@ def validate_sample(obj: Any, *, source: str = "<sample>", line: int | None = No
 
     if not isinstance(obj, dict):
         raise err(f"expected a JSON object, got {type(obj).__name__}")
-    for key, kind in _REQUIRED.items():
-        _require(obj, key, kind, err)
-    if obj["schema_version"] != SCHEMA_VERSION:
+    # The version first: a recording of another schema fails on that, not on a field it lacks.
+    version = _require(obj, "schema_version", str, err)
+    if version != SCHEMA_VERSION:
         raise err(
-            f"version {obj['schema_version']!r} is not the supported {SCHEMA_VERSION!r}",
+            f"version {version!r} is not the supported {SCHEMA_VERSION!r} (re-record it)",
             field="schema_version",
         )
+    for key, kind in _REQUIRED.items():
+        _require(obj, key, kind, err)
     if obj["sample_index"] < 0:
         raise err("must be >= 0", field="sample_index")
     if not math.isfinite(obj["t"]):
@@ -214,8 +229,11 @@ def _features(rows: list, err: Any) -> np.ndarray:
     expected_type[N_JOINTS:, 1] = 1.0
     if not np.array_equal(x[:, :2], expected_type):
         raise err("node-type indicators do not match the node order", field="x.is_joint/is_sensor")
-    if np.any(x[:N_JOINTS, SENSOR_CHANNELS] != 0.0):
-        raise err("joint nodes must zero the sensor channels", field="x.vib/acc")
+    stray = np.argwhere(x[:N_JOINTS, SENSOR_CHANNELS] != 0.0)
+    if stray.size:
+        node, feat = stray[0]
+        name = f"x[{NODE_NAMES[node]}].{SENSOR_FEATURES[feat]}"
+        raise err("joint nodes must zero the sensor channels", field=name)
     return x.astype(np.float32)
 
 

@@ -13,6 +13,7 @@ from robohealth_mj.corpus import build_corpus, plan
 from robohealth_mj.data.jsonl import read_samples
 from robohealth_mj.dataset import main as dataset_main
 from robohealth_mj.recorder import GRAPHS_FILE, record_session
+from robohealth_mj.schema import SCHEMA_VERSION
 
 FAST_FAULTS = [
     "faults.schedule.fault_s=1.0",
@@ -165,3 +166,24 @@ def test_corpus_records_roles_in_parallel_and_resumes(tmp_path):
     again = {p: p.stat().st_mtime_ns for p in tmp_path.glob(f"*/{GRAPHS_FILE}")}
     changed = [p.parent.name for p in first if first[p] != again[p]]
     assert changed == ["heldout_seed900"]
+    # another fault model is another session: recorded anew, not reused
+    build_corpus(corpus, tmp_path, jobs=2, extra=["faults.fault_model=hybrid"], progress=False)
+    hybrid = {p: p.stat().st_mtime_ns for p in tmp_path.glob(f"*/{GRAPHS_FILE}")}
+    assert all(hybrid[p] != again[p] for p in again)
+
+
+def test_corpus_fault_model_and_quoted_record_overrides_compose():
+    """The documented forms: ``fault_model=hybrid`` and a quoted ``record_overrides`` element."""
+    cfg = compose_config("corpus", ["fault_model=hybrid", 'record_overrides=["faults.ramp_s=1.0"]'])
+    assert cfg.fault_model == "hybrid" and list(cfg.record_overrides) == ["faults.ramp_s=1.0"]
+    assert compose_config("corpus").fault_model == "physics"
+
+
+def test_a_schema_1_recording_is_refused_naming_the_file_and_both_versions(tmp_path, capsys):
+    old = tmp_path / "v1.jsonl"
+    line = {"schema_version": "1.0", "recording_run_id": "old", "sample_index": 0, "t": 0.05}
+    old.write_text(json.dumps(line) + "\n")
+    assert dataset_main(["summarize", str(old)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(old) in err[0]
+    assert "'1.0'" in err[0] and f"'{SCHEMA_VERSION}'" in err[0]

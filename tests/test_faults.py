@@ -5,14 +5,15 @@ from __future__ import annotations
 
 import copy
 import functools
+import json
 
 import numpy as np
 import pytest
 from omegaconf import OmegaConf
 
 from robohealth_mj.config import compose_config
+from robohealth_mj.effect_sizes import _readings, by_hops, effect_by_sensor
 from robohealth_mj.faults.catalogue import MODES, FaultParameters, Scenario
-from robohealth_mj.faults.effects import _readings, by_hops, effect_by_sensor
 from robohealth_mj.faults.mechanical import DriveFaults
 from robohealth_mj.faults.scheduler import FaultScheduler, FixedFault
 from robohealth_mj.recorder import build_simulator
@@ -94,6 +95,65 @@ def test_physics_friction_raises_the_effort_of_the_target_drive():
     state, _, _ = _simulate(*_fixed("friction", "elbow", "faults.fault_model=physics", *moving))
     j = JOINT_NAMES.index("elbow")
     assert np.abs(state[:, j, 2]).mean() > np.abs(h_state[:, j, 2]).mean() + 2.0
+
+
+def _chunks(*overrides: str, seconds: float = SECONDS) -> dict[str, np.ndarray]:
+    cfg = compose_config("record", ["seed=3", "session.progress=false", *overrides])
+    sim = build_simulator(cfg)
+    chunks = list(sim.run(round(seconds / sim.tick_s)))
+    return {
+        k: np.concatenate([getattr(c, k) for c in chunks])
+        for k in vars(chunks[0])
+        if isinstance(getattr(chunks[0], k), np.ndarray) and getattr(chunks[0], k).ndim
+    }
+
+
+def test_torque_residual_is_near_zero_healthy_and_rises_by_the_added_friction(model):
+    """The drive torque minus the controller's model torque: what a UR's friction monitoring
+    watches. Under a friction fault it must carry exactly the friction the model does not know."""
+    moving = ["curriculum.families=[whole_arm]", "curriculum.speed_scales=[1.0]"]
+    healthy = _chunks("faults=none", *moving)
+    faulted = _chunks(*_fixed("friction", "elbow", "faults.schedule.severity=0.9"), *moving)
+    j = JOINT_NAMES.index("elbow")
+    p = _default_params()["physics"]["friction"]
+    dof = int(model.joint("elbow_joint").dofadr[0])
+    coulomb = model.dof_frictionloss[dof] * p["coulomb_gain"] * 0.9
+    viscous = model.dof_damping[dof] * p["viscous_gain"] * 0.9
+    v = healthy["vel"][:, j]
+    after_ramp = np.arange(v.size) >= 20  # the fault develops over its first 0.5 s
+    moving_ticks = after_ramp & (np.abs(v) > 0.05)
+    added = coulomb * np.sign(v) + viscous * v  # what the extra friction costs the drive
+    shift = faulted["effort_residual"][:, j] - healthy["effort_residual"][:, j]
+    healthy_rms = np.sqrt((healthy["effort_residual"][moving_ticks, j] ** 2).mean())
+    assert healthy_rms < 0.1 * np.abs(added[moving_ticks]).mean()
+    slope = (shift[moving_ticks] @ added[moving_ticks]) / (
+        added[moving_ticks] @ added[moving_ticks]
+    )
+    assert 0.8 < slope < 1.2, slope
+
+
+def test_a_softer_drive_moves_the_piezo_energy_to_a_lower_band():
+    """Lower the distal drive's stiffness 4x (its resonance halves); a jam's impacts excite it."""
+    jam = _fixed("jam", "wrist_3", "faults.schedule.severity=0.5")
+
+    def band_centroid(stiffness: float) -> float:
+        run = _chunks(*jam, f"+sim.drive_overrides={{wrist_3:{{stiffness:{stiffness}}}}}")
+        energy = (run["bands"][:, JOINT_NAMES.index("wrist_3")] ** 2).mean(axis=0)
+        return float((energy / energy.sum()) @ np.arange(energy.size))
+
+    nominal, softer = band_centroid(100.0), band_centroid(25.0)
+    assert softer < 0.6 * nominal, (nominal, softer)
+
+
+def test_tracking_error_shows_a_backlash_dead_band_under_load(healthy):
+    """With a wider dead band the loaded link sits off its target by about the added gap."""
+    run = _chunks(*_fixed("backlash", "elbow", "faults.schedule.severity=0.9"))
+    h = _chunks("faults=none")
+    j = JOINT_NAMES.index("elbow")
+    gap = _default_params()["physics"]["backlash"]["gap_rad"] * 0.9
+    offset = np.abs(run["pos_error"][40:, j]).mean()
+    assert np.abs(h["pos_error"][40:, j]).mean() < 0.1 * gap
+    assert 0.5 * gap < offset < 1.5 * gap, (offset, gap)
 
 
 def test_analytic_mode_leaves_the_physics_healthy(healthy):
@@ -193,3 +253,16 @@ def test_bad_fault_config_is_a_clear_error():
 def _default_params() -> dict:
     p = OmegaConf.to_container(compose_config("record").fault_params)
     return {"physics": p["physics"], "analytic": p["analytic"]}
+
+
+def test_effects_tool_prints_a_row_per_fault_joint_and_severity(capsys, tmp_path):
+    from robohealth_mj.effects import main as effects_main
+
+    out = tmp_path / "rows.json"
+    args = ["--seconds", "2", "--classes", "friction", "--joints", "elbow", "wrist_3"]
+    effects_main([*args, "--severities", "0.9", "--json", str(out)])
+    printed = [line for line in capsys.readouterr().out.splitlines() if line.startswith("friction")]
+    assert len(printed) == 2
+    rows = json.loads(out.read_text())
+    assert [r["joint"] for r in rows] == ["elbow", "wrist_3"]
+    assert all(r["channels"]["effort_residual"] > 3.0 for r in rows)  # the drive works harder

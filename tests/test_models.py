@@ -17,6 +17,8 @@ from robohealth_mj.models import VARIANTS as ALL_VARIANTS
 from robohealth_mj.models.backbone import ThesisBackbone, WindowBackbone
 from robohealth_mj.models.onnx import export_onnx, onnx_parity
 
+F = schema.N_FEATURES
+
 ROOT = Path(__file__).resolve().parents[1] / "conf"
 CONF = ROOT / "model"
 VARIANTS = sorted(p.stem for p in CONF.glob("*.yaml") if p.stem != "gbdt")
@@ -60,7 +62,7 @@ def test_output_shapes(name, window, backbone):
     model = _build(name, window, backbone=backbone).eval()
     for batch in (1, 128):
         with torch.no_grad():
-            out = model(torch.randn(batch, window, 12, 9))
+            out = model(torch.randn(batch, window, 12, F))
         assert out["class_logits"].shape == (batch, 7)
         assert out["joint_logits"].shape == (batch, 6)  # joints only: a sensor can never win
         if "recon_energy" in out:
@@ -73,7 +75,7 @@ def test_output_shapes(name, window, backbone):
 @pytest.mark.parametrize("name", VARIANTS)
 def test_gradients_reach_every_parameter(name, backbone):
     model = _build(name, severity_head=True, backbone=backbone).train()
-    out = model(torch.randn(4, 8, 12, 9))
+    out = model(torch.randn(4, 8, 12, F))
     loss = sum(v.float().sum() for v in out.values())
     loss.backward()
     missing = [n for n, p in model.named_parameters() if p.grad is None or not p.grad.abs().sum()]
@@ -85,9 +87,9 @@ def test_gradients_reach_every_parameter(name, backbone):
 def test_the_default_backbone_is_the_window_one_and_thesis_rebuilds_the_thesis_model():
     """``backbone=thesis`` composes the thesis's per-snapshot GCN + GRU + attention."""
 
-    def composed(*overrides):
+    def composed(*overrides, features=schema.N_FEATURES):
         cfg = compose_config("train", ["variant=stgnn_fixed", *overrides])
-        return build_model(cfg.model, schema.adjacency(), 6, schema.N_FEATURES, 16)
+        return build_model(cfg.model, schema.adjacency(), 6, features, 16)
 
     window = composed()
     assert isinstance(window.backbone, WindowBackbone) and window.classifier.max_pool
@@ -95,15 +97,17 @@ def test_the_default_backbone_is_the_window_one_and_thesis_rebuilds_the_thesis_m
     assert isinstance(thesis.backbone, ThesisBackbone) and not thesis.classifier.max_pool
     assert isinstance(thesis.backbone.gru, torch.nn.GRU)
     assert thesis.backbone.attention is not None
-    assert sum(p.numel() for p in thesis.parameters()) == 80_584  # the thesis model's size
+    # the thesis model's size, on the thesis's 9 input features (schema 1.0)
+    thesis_inputs = composed("backbone=thesis", features=9)
+    assert sum(p.numel() for p in thesis_inputs.parameters()) == 80_584
 
 
 @pytest.mark.parametrize("backbone", ["window", "thesis"])
 def test_mlp_encodes_each_node_on_its_own(backbone):
     model = _build("mlp", backbone=backbone).eval()
-    x = torch.randn(2, 8, 12, 9)
+    x = torch.randn(2, 8, 12, F)
     changed = x.clone()
-    changed[:, :, 4] += torch.randn(2, 8, 9)
+    changed[:, :, 4] += torch.randn(2, 8, F)
     with torch.no_grad():
         a, b = model.node_embeddings(x), model.node_embeddings(changed)
     others = [k for k in range(12) if k != 4]
@@ -114,7 +118,7 @@ def test_mlp_encodes_each_node_on_its_own(backbone):
 @pytest.mark.parametrize("name", ["stgnn_fixed_pose", "stgnn_pose_cond", "pose_anomaly"])
 def test_gamma_zero_recovers_the_unconditioned_graph(name):
     model = _build(name).eval()
-    x = torch.randn(3, 8, 12, 9)
+    x = torch.randn(3, 8, 12, F)
     with torch.no_grad():
         model.adjacency.pose.gamma.zero_()
         gated = model(x)
@@ -165,7 +169,7 @@ def test_four_sensors_mixing_six_joints(name):
     adj[:6, 6:] = adj[6:, :6] = 1.0
     model = _build(name, adjacency=adj).eval()
     with torch.no_grad():
-        out = model(torch.randn(5, 8, 10, 9))
+        out = model(torch.randn(5, 8, 10, F))
     assert out["joint_logits"].shape == (5, 6) and out["class_logits"].shape == (5, 7)
     if hasattr(model, "anomaly") and model.anomaly is not None:
         assert model.anomaly.coupling().shape == (6, 4)
@@ -184,7 +188,23 @@ def test_onnx_export_matches_pytorch_with_a_dynamic_batch(name, tmp_path):
     with torch.no_grad():  # non-trivial node embeddings, so parity covers them
         model.backbone.encoder.node.normal_()
     path = tmp_path / f"{name}.onnx"
-    names = export_onnx(model, torch.randn(2, 16, 12, 9), path)
+    names = export_onnx(model, torch.randn(2, 16, 12, F), path)
     assert names[:2] == ["class_logits", "joint_logits"]
     for batch in (1, 7):
-        assert onnx_parity(model, path, torch.randn(batch, 16, 12, 9)) < 1e-4
+        assert onnx_parity(model, path, torch.randn(batch, 16, 12, F)) < 1e-4
+
+
+def test_gbdt_reads_only_the_channels_it_is_given():
+    """Channel ablations: the trees' features come from the named channels only."""
+    from robohealth_mj.models.gbdt import GradientBoostedTrees
+
+    adj = torch.as_tensor(schema.adjacency())
+    x = torch.randn(3, 8, 12, F)
+    every = GradientBoostedTrees(adj, 6, F, 8).features(x)
+    two = GradientBoostedTrees(adj, 6, F, 8, channels=["vib", "pos_error"]).features(x)
+    assert every.shape == (3, 12 * (F - 2) * 7) and two.shape == (3, 12 * 2 * 7)
+    x[..., schema.feature_index("effort")] += 5.0  # a channel it does not read
+    again = GradientBoostedTrees(adj, 6, F, 8, channels=["vib", "pos_error"]).features(x)
+    np.testing.assert_array_equal(two, again)
+    with pytest.raises(ValueError, match="unknown"):
+        GradientBoostedTrees(adj, 6, F, 8, channels=["torque"])

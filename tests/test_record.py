@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from robohealth_mj import schema
 from robohealth_mj.data.jsonl import read_samples
 from robohealth_mj.recorder import GRAPHS_FILE, MANIFEST_FILE, record_session
 
@@ -40,7 +41,7 @@ def test_a_120_s_session_has_2400_valid_samples_and_a_complete_manifest(record_c
     on_disk = json.loads((tmp_path / MANIFEST_FILE).read_text())
     assert on_disk["status"] == "complete"
     assert on_disk["sample_count"] == on_disk["expected_samples"] == 2400
-    assert on_disk["schema_version"] == "1.0"
+    assert on_disk["schema_version"] == schema.SCHEMA_VERSION == "2.0"
     assert on_disk["config"]["seed"] == 11
     assert on_disk["code_version"]
     assert max(on_disk["stats"]["tracking_rms_rad"].values()) < 0.01

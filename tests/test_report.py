@@ -42,6 +42,8 @@ def _run(
         "localisation_accuracy": loc,
         "per_class": per_class,
         "confusion_matrix": [[1] * 7 for _ in range(7)],
+        "by_severity": {"0.3": {"accuracy": acc - 0.2}},
+        "by_motion": {"moving": {"accuracy": acc}, "still": {"accuracy": acc - 0.3}},
     }
     heldout = {"metrics": metrics}
     if corr is not None:
@@ -61,6 +63,13 @@ def test_report_aggregates_seeds_and_writes_tables_and_figures(tmp_path):
     assert "| mlp | 16 | 1 |" in text and "gat" not in text
     assert text.index("| mlp |") < text.index("| stgnn_fixed |")  # thesis order
     assert "0.900 ± 0.000" in text  # the harness run's C-C0 correlation
+    # what each fault shows: recall per class, severity 0.3 and moving/still faulted windows
+    visibility = text[text.index("### Held-out recall per class") :]
+    row = next(line for line in visibility.splitlines() if "| stgnn_fixed |" in line)
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[3:9] == ["0.500 ± 0.000"] * 6  # the six fault classes' recall
+    assert cells[9] == "0.700 ± 0.082" and cells[11] == "—"  # sev. 0.3; no 0.9 stratum
+    assert cells[12:] == ["0.900 ± 0.082", "0.600 ± 0.082"]  # moving, still
     assert (tmp_path / "report" / "results.md").is_file()
     assert (tmp_path / "report" / "results.csv").read_text().startswith("graph,variant,window")
     assert {p.name for p in figures} >= {

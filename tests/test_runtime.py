@@ -23,6 +23,8 @@ from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 from robohealth_mj.schema import FaultLabel
 from robohealth_mj.train import run
 
+F = schema.N_FEATURES
+
 FAST = [
     "session.progress=false",
     "faults.schedule.fault_s=1.0",
@@ -77,7 +79,7 @@ def test_export_matches_pytorch_on_raw_windows_and_carries_metadata(deployed, gr
     import onnxruntime as ort
 
     session = ort.InferenceSession(str(deployed[f"{graph}_onnx"]))
-    assert session.get_inputs()[0].shape[1:] == [8, 12, 9]  # raw schema windows, dynamic batch
+    assert session.get_inputs()[0].shape[1:] == [8, 12, F]  # raw schema windows, dynamic batch
     rec = load_recordings([deployed["heldout"]])
     x = torch.from_numpy(rec.x[np.arange(100, 108)][None].repeat(3, 0))
     model = model_from_checkpoint(ckpt)

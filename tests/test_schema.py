@@ -17,7 +17,10 @@ from robohealth_mj.schema import FaultLabel, SchemaError, validate_sample
 
 def _sample_obj(index: int = 0) -> dict:
     rng = np.random.default_rng(index)
-    x = node_features(*(rng.normal(size=6) for _ in range(4)), rng.normal(size=(6, 3)))
+    x = node_features(
+        rng.normal(size=(6, len(schema.STATE_FEATURES))),
+        rng.normal(size=(6, len(schema.SENSOR_FEATURES))),
+    )
     line = format_line(
         "run-a",
         index,
@@ -32,7 +35,8 @@ def _sample_obj(index: int = 0) -> dict:
 def test_graph_has_the_canonical_nodes_and_bidirectional_edges():
     assert schema.NODE_NAMES[:6] == schema.JOINT_NAMES
     assert schema.NODE_NAMES[6:] == tuple(f"{j}_sensor" for j in schema.JOINT_NAMES)
-    assert len(schema.FEATURE_NAMES) == 9
+    assert len(schema.FEATURE_NAMES) == schema.N_FEATURES == 15
+    assert schema.FEATURE_NAMES[schema.SENSOR_CHANNELS] == schema.SENSOR_FEATURES
     edges = set(schema.EDGES)
     assert len(edges) == 2 * 5 + 2 * 6
     assert all((j, i) in edges for i, j in edges)
@@ -45,9 +49,11 @@ def test_graph_has_the_canonical_nodes_and_bidirectional_edges():
 def test_a_formatted_line_validates_and_round_trips():
     obj = _sample_obj()
     sample = validate_sample(obj)
-    assert sample.x.shape == (12, 9)
-    np.testing.assert_array_equal(sample.x[:6, 5:], 0.0)
-    np.testing.assert_allclose(sample.x[6:, 2:5], sample.x[:6, 2:5])
+    assert sample.x.shape == (12, schema.N_FEATURES)
+    np.testing.assert_array_equal(sample.x[:6, schema.SENSOR_CHANNELS], 0.0)
+    np.testing.assert_allclose(
+        sample.x[6:, schema.STATE_CHANNELS], sample.x[:6, schema.STATE_CHANNELS]
+    )
     assert sample.fault.fault_class == "none" and not sample.fault.active
 
 
@@ -69,12 +75,12 @@ _DELETE = object()
 
 
 def _nan_in_x(x):
-    x[8][6] = float("nan")
+    x[8][schema.feature_index("acc_x")] = float("nan")
     return x
 
 
 def _joint_with_vibration(x):
-    x[2][5] = 0.5
+    x[2][schema.feature_index("vib")] = 0.5
     return x
 
 
@@ -86,7 +92,7 @@ def _joint_with_vibration(x):
         (_set("x", _nan_in_x), "x[elbow_sensor].acc_x"),
         (_set("nodes", lambda n: n[::-1]), "nodes"),
         (_set("edge_index", lambda e: [e[0][:-2], e[1][:-2]]), "edge_index"),
-        (_set("x", _joint_with_vibration), "x.vib/acc"),
+        (_set("x", _joint_with_vibration), "x[elbow].vib"),
         (_set("x", lambda x: x[:11]), "x"),
         (_set("fault.class", "melted"), "fault.class"),
         (_set("fault.severity", 1.5), "fault.severity"),

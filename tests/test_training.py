@@ -14,11 +14,18 @@ from robohealth_mj import schema
 from robohealth_mj.config import compose_config
 from robohealth_mj.data.arrays import Recording, load_recordings
 from robohealth_mj.data.graphs import DEFAULT_C0, coupling_correlation, harness_graph
-from robohealth_mj.data.windows import make_windows, normalisation, run_aware_split
+from robohealth_mj.data.windows import (
+    make_windows,
+    normalisation,
+    run_aware_split,
+    target_joint_moved,
+)
 from robohealth_mj.learn.checkpoint import load_checkpoint
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
 from robohealth_mj.recorder import GRAPHS_FILE, record_session
 from robohealth_mj.train import run
+
+F = schema.N_FEATURES
 
 
 def _recording(runs: list[int], seed: int = 0) -> Recording:
@@ -29,7 +36,7 @@ def _recording(runs: list[int], seed: int = 0) -> Recording:
     index = np.concatenate([np.arange(n) for n in runs]).astype(np.int64)
     cls = (np.arange(total) // 10) % 7
     return Recording(
-        x=rng.normal(size=(total, 12, 9)).astype(np.float32),
+        x=rng.normal(size=(total, 12, F)).astype(np.float32),
         run=run,
         run_ids=[f"run{k}" for k in range(len(runs))],
         sample_index=index,
@@ -40,6 +47,20 @@ def _recording(runs: list[int], seed: int = 0) -> Recording:
         payload_scale=np.ones(total, np.float32),
         sources=["synthetic"],
     )
+
+
+def test_motion_strata_flag_windows_whose_faulted_joint_turned():
+    """Friction acts only on a moving joint: the evaluation splits faulted windows by motion."""
+    rec = _recording([80])
+    vel = schema.feature_index("vel")
+    rec.x[..., vel] = 0.0
+    rec.x[12, 2, vel] = 0.5  # joint 2 turns once, inside the class-2 block (samples 10-19)
+    windows = make_windows(rec, 4, stride=1)
+    moved = target_joint_moved(rec, windows)
+    label_joint = rec.fault_joint[windows.end]
+    assert moved[(windows.start <= 12) & (windows.end >= 12) & (label_joint == 2)].all()
+    assert moved.sum() == ((windows.start <= 12) & (windows.end >= 12) & (label_joint == 2)).sum()
+    assert not moved[label_joint < 0].any()  # healthy windows are never "moving faults"
 
 
 def test_split_keeps_every_session_in_one_split_and_is_seeded():
@@ -73,7 +94,7 @@ def test_windows_stay_inside_a_run_and_take_the_final_snapshot_label():
     from robohealth_mj.learn.data import WindowTensors
 
     tensors = WindowTensors(
-        rec.x, rec, np.zeros((12, 9), np.float32), np.ones((12, 9), np.float32), torch.device("cpu")
+        rec.x, rec, np.zeros((12, F), np.float32), np.ones((12, F), np.float32), torch.device("cpu")
     )
     batch = tensors.batch(windows, np.arange(len(windows)))
     np.testing.assert_array_equal(batch.fault_class.numpy(), rec.fault_class[windows.end])
@@ -94,14 +115,15 @@ def test_normalisation_uses_the_training_windows_only():
 
 
 def test_harness_mixes_the_sensor_packages_through_c0():
-    x = np.random.default_rng(0).normal(size=(5, 12, 9)).astype(np.float32)
+    x = np.random.default_rng(0).normal(size=(5, 12, F)).astype(np.float32)
     graph = harness_graph()
     h = graph.transform(x)
-    assert h.shape == (5, 10, 9)
+    assert h.shape == (5, 10, F)
     np.testing.assert_array_equal(h[:, :6], x[:, :6])
-    expected = np.einsum("jm,tjc->tmc", DEFAULT_C0, x[:, 6:, 5:9])
-    np.testing.assert_allclose(h[:, 6:, 5:9], expected, rtol=1e-5, atol=1e-6)
-    np.testing.assert_array_equal(h[:, 6:, 2:5], 0.0)  # no joint state on harness sensors
+    expected = np.einsum("jm,tjc->tmc", DEFAULT_C0, x[:, 6:, schema.SENSOR_CHANNELS])
+    np.testing.assert_allclose(h[:, 6:, schema.SENSOR_CHANNELS], expected, rtol=1e-5, atol=1e-6)
+    # no joint state on harness sensors
+    np.testing.assert_array_equal(h[:, 6:, schema.STATE_CHANNELS], 0.0)
     np.testing.assert_array_equal(h[:, 6:, 1], 1.0)
     assert graph.adjacency[:6, 6:].all() and not graph.adjacency[6:, 6:].any()
     assert coupling_correlation(DEFAULT_C0 * 3.0, DEFAULT_C0) == pytest.approx(1.0)
@@ -153,7 +175,7 @@ def test_tiny_train_then_evaluate_end_to_end(tiny_corpus, tmp_path):
     assert sum(len(v) for v in summary["split_runs"].values()) == 3
     ckpt = load_checkpoint(tmp_path / "best.ckpt")  # weights_only=True
     assert ckpt["schema"]["node_names"] == list(schema.NODE_NAMES)
-    assert ckpt["norm_mean"].shape == (12, 9) and ckpt["variant"] == "anomaly_residual"
+    assert ckpt["norm_mean"].shape == (12, F) and ckpt["variant"] == "anomaly_residual"
     assert ckpt["data_fingerprint"] == summary["data_fingerprint"]
     heldout = json.loads((tmp_path / "eval_heldout.json").read_text())
     m = heldout["metrics"]
@@ -256,7 +278,7 @@ def learnable_corpus(tmp_path_factory) -> Path:
         "faults.schedule.fault_s=3.0",
         "faults.schedule.healthy_s=1.5",
         "faults.schedule.severities=[0.9]",
-        "faults.schedule.classes=[jam,friction,sensor_drift]",
+        "faults.schedule.classes=[jam,backlash,sensor_drift]",  # visible with the joint at rest
         "faults.schedule.joints=[shoulder_lift,elbow,wrist_2]",
         "session.passes=2",
     ]

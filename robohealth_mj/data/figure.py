@@ -7,7 +7,9 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj.data.jsonl import read_samples
-from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, N_JOINTS
+from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, N_JOINTS, feature_index
+
+_VIB_ACC = [feature_index(name) for name in ("vib", "acc_x", "acc_y", "acc_z")]
 
 
 def _episodes(path: Path) -> dict[str, tuple[int, np.ndarray, np.ndarray]]:
@@ -30,9 +32,11 @@ def _episodes(path: Path) -> dict[str, tuple[int, np.ndarray, np.ndarray]]:
     for cls, (_, a, b) in best.items():
         joint = JOINT_NAMES.index(labels[a][1])
         node = N_JOINTS + joint
-        faulted = np.array([samples[i].x[node, 5:9] for i in range(a, b)])
+        faulted = np.array([samples[i].x[node, _VIB_ACC] for i in range(a, b)])
         after = range(b, min(len(samples), b + (b - a)))
-        healthy = np.array([samples[i].x[node, 5:9] for i in after if not samples[i].fault.active])
+        healthy = np.array(
+            [samples[i].x[node, _VIB_ACC] for i in after if not samples[i].fault.active]
+        )
         out[cls] = (joint, faulted, healthy)
     return out
 

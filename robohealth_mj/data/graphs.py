@@ -37,7 +37,7 @@ class GraphSpec:
     coupling: np.ndarray | None = None  # C0 [J, M] for the harness
 
     def transform(self, x: np.ndarray) -> np.ndarray:
-        """Schema snapshots ``[..., 12, 9]`` -> this graph's node features ``[..., N, 9]``."""
+        """Schema snapshots ``[..., 12, F]`` -> this graph's node features ``[..., N, F]``."""
         if self.coupling is None:
             return x
         j = schema.N_JOINTS

@@ -17,6 +17,8 @@ from robohealth_mj.schema import (
     N_JOINTS,
     NODE_NAMES,
     SCHEMA_VERSION,
+    SENSOR_CHANNELS,
+    STATE_CHANNELS,
     FaultLabel,
     GraphSample,
     SchemaError,
@@ -31,17 +33,19 @@ _EDGES_JSON = json.dumps([[i for i, _ in EDGES], [j for _, j in EDGES]])
 _X_TEMPLATE = ",".join(["[" + ",".join(["%.6g"] * N_FEATURES) + "]"] * (2 * N_JOINTS))
 
 
-def node_features(
-    pos: np.ndarray, vel: np.ndarray, effort: np.ndarray, vib: np.ndarray, acc: np.ndarray
-) -> np.ndarray:
-    """Assemble ``[12, 9]`` node features for one tick from per-joint readings."""
-    x = np.zeros((2 * N_JOINTS, 9))
-    x[:N_JOINTS, 0] = 1.0
-    x[N_JOINTS:, 1] = 1.0
-    for block in (slice(0, N_JOINTS), slice(N_JOINTS, 2 * N_JOINTS)):
-        x[block, 2], x[block, 3], x[block, 4] = pos, vel, effort
-    x[N_JOINTS:, 5] = vib
-    x[N_JOINTS:, 6:9] = acc
+def node_features(state: np.ndarray, sensor: np.ndarray) -> np.ndarray:
+    """Assemble ``[..., 12, F]`` node features from per-joint readings.
+
+    ``state [..., 6, len(STATE_FEATURES)]`` goes to each joint node and to its sensor node;
+    ``sensor [..., 6, len(SENSOR_FEATURES)]`` to the sensor nodes only.
+    """
+    lead = state.shape[:-2]
+    x = np.zeros((*lead, 2 * N_JOINTS, N_FEATURES))
+    x[..., :N_JOINTS, 0] = 1.0
+    x[..., N_JOINTS:, 1] = 1.0
+    x[..., :N_JOINTS, STATE_CHANNELS] = state
+    x[..., N_JOINTS:, STATE_CHANNELS] = state
+    x[..., N_JOINTS:, SENSOR_CHANNELS] = sensor
     return x
 
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robohealth_mj.data.arrays import Recording
+from robohealth_mj.schema import feature_index
 
 
 @dataclass
@@ -40,6 +41,25 @@ def make_windows(rec: Recording, window: int, stride: int | None = None) -> Wind
     bounds = np.concatenate([[0], breaks, [len(rec)]])
     starts = [np.arange(a, b - window + 1, stride) for a, b in itertools.pairwise(bounds)]
     return Windows(np.concatenate(starts).astype(np.int64), window)
+
+
+MOVING_RAD_S = 0.05  # a joint turning slower than this (3 deg/s) counts as still
+
+
+def target_joint_moved(
+    rec: Recording, windows: Windows, threshold: float = MOVING_RAD_S
+) -> np.ndarray:
+    """Per window ``[K]``: the faulted joint of its final snapshot turned faster than
+    ``threshold`` at some tick of the window (False for healthy windows).
+
+    Friction and backlash act only on a moving (or reversing) joint, so their evidence exists only
+    in such windows; the evaluation reports both strata.
+    """
+    joint = rec.fault_joint[windows.end]
+    offsets = np.arange(windows.window)
+    rows = windows.start[:, None] + offsets[None, :]  # [K, W]
+    speed = np.abs(rec.x[rows, np.maximum(joint, 0)[:, None], feature_index("vel")])
+    return (joint >= 0) & (speed.max(axis=1) > threshold)
 
 
 SPLITS = ("train", "val", "test")

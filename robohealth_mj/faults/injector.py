@@ -3,7 +3,9 @@ physics, which torques to apply, and how to alter the readings, per the ``fault_
 
 - ``physics``: mechanical faults change the dynamics only;
 - ``analytic``: the physics stays healthy and the thesis's Table 2 signatures are painted on;
-- ``hybrid`` (default): both. Sensor faults act on the readings in every model.
+- ``hybrid``: both (the thesis's setting; ``physics`` is the default).
+
+Sensor faults act on the readings in every model.
 """
 
 from __future__ import annotations
@@ -98,4 +100,4 @@ def _smoothstep(u: float) -> float:
 
 def healthy_injector(model: mujoco.MjModel, tick_s: float) -> FaultInjector:
     """An injector that never injects (for healthy sessions built without a fault config)."""
-    return FaultInjector(NoFaults(), FaultParameters({}, {}), "hybrid", model, tick_s, 0)
+    return FaultInjector(NoFaults(), FaultParameters({}, {}), "physics", model, tick_s, 0)

@@ -16,13 +16,15 @@ from robohealth_mj.schema import N_JOINTS, hop_distance
 @dataclass
 class TickReadings:
     """Per-tick readings of one chunk, edited in place: pos/vel/effort ``[n, 6]``, vib ``[n, 6]``,
-    acc ``[n, 6, 3]``."""
+    acc ``[n, 6, 3]``, piezo sub-bands ``[n, 6, 3]``, kurtosis ``[n, 6]``."""
 
     pos: np.ndarray
     vel: np.ndarray
     effort: np.ndarray
     vib: np.ndarray
     acc: np.ndarray
+    bands: np.ndarray
+    kurtosis: np.ndarray
 
 
 class ReadingFaults:
@@ -100,6 +102,9 @@ class ReadingFaults:
                 self.tick_s
             )
             self._drift[j] += step
+            # The drift offsets the transmitter's level output (and the MEMS axes); the sub-band
+            # levels are filtered digitally from the raw signal, where an offset is DC and the
+            # band-pass removes it.
             r.vib[k, j] = abs(r.vib[k, j] + self._drift[j, 0])
             r.acc[k, j] += self._drift[j, 1:]
 
@@ -109,6 +114,9 @@ class ReadingFaults:
         n = r.vib.shape[0]
         r.vib[:] = np.abs(r.vib + rng.normal(0.0, 1.0, (n, N_JOINTS)) * w * p["sigma_vib"])
         r.acc += rng.normal(0.0, 1.0, (n, N_JOINTS, 3)) * (w * p["sigma_acc"])[None, :, None]
+        # Broadband transducer noise spreads over the sub-bands (a third of its power in each).
+        sigma_band = (w * p["sigma_vib"] / np.sqrt(r.bands.shape[-1]))[None, :, None]
+        r.bands[:] = np.abs(r.bands + rng.normal(0.0, 1.0, r.bands.shape) * sigma_band)
 
     # the thesis's analytic signatures (Table 2), layered on the physics readings
 

@@ -9,7 +9,7 @@ from typing import Any
 
 from robohealth_mj.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.data.arrays import load_recordings
-from robohealth_mj.data.windows import make_windows
+from robohealth_mj.data.windows import make_windows, target_joint_moved
 from robohealth_mj.learn.checkpoint import (
     check_schema,
     graph_from_checkpoint,
@@ -44,7 +44,7 @@ def evaluate_checkpoint(
     )
     model = model_from_checkpoint(ckpt).to(dev)
     windows = make_windows(rec, int(ckpt["window"]), ckpt["config"].get("stride"))
-    metrics = metrics_of(predict(model, tensors, windows))
+    metrics = metrics_of(predict(model, tensors, windows), target_joint_moved(rec, windows))
     return {
         "checkpoint": str(ckpt_path),
         "variant": ckpt["variant"],

@@ -1,4 +1,4 @@
-"""The metric set of thesis §2.7, overall and stratified by severity.
+"""The metric set of thesis §2.7, overall, by severity, and by whether the faulted joint moved.
 
 Fault presence: the class argmax is anything but ``none``. Localisation: the joint argmax against
 the injected joint, on windows whose final snapshot has an active fault.
@@ -55,8 +55,11 @@ def compute_metrics(
     active: np.ndarray,
     severity: np.ndarray,
     severity_pred: np.ndarray | None = None,
+    target_moving: np.ndarray | None = None,
 ) -> dict[str, Any]:
-    """All metrics, plus the same metrics on the windows of each injected severity level."""
+    """All metrics, plus the same metrics on the faulted windows of each injected severity level
+    and, given ``target_moving [K]``, on faulted windows whose faulted joint moved or stood
+    still."""
     args = (pred_class, pred_joint, true_class, true_joint, active, severity, severity_pred)
     result = _scalar_metrics(*args)
     strata = {}
@@ -64,6 +67,11 @@ def compute_metrics(
         mask = active & np.isclose(severity, level)
         strata[f"{level:g}"] = _scalar_metrics(*(a[mask] if a is not None else None for a in args))
     result["by_severity"] = strata
+    if target_moving is not None:
+        result["by_motion"] = {
+            name: _scalar_metrics(*(a[active & m] if a is not None else None for a in args))
+            for name, m in (("moving", target_moving), ("still", ~target_moving))
+        }
     return result
 
 

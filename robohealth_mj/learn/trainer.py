@@ -59,7 +59,7 @@ def expand_paths(patterns: list[str] | str) -> list[Path]:
     return list(dict.fromkeys(resolve_recordings(found)))
 
 
-def metrics_of(pred: Predictions) -> dict[str, Any]:
+def metrics_of(pred: Predictions, target_moving: np.ndarray | None = None) -> dict[str, Any]:
     return compute_metrics(
         pred.class_logits.argmax(1),
         pred.joint_logits.argmax(1),
@@ -68,6 +68,7 @@ def metrics_of(pred: Predictions) -> dict[str, Any]:
         pred.active,
         pred.true_severity,
         pred.severity,
+        target_moving,
     )
 
 

@@ -19,6 +19,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from robohealth_mj import schema
 from robohealth_mj.models.statistics import window_statistics
 
 
@@ -56,6 +57,7 @@ class GradientBoostedTrees(nn.Module):
         max_bin: int = 63,
         metric: str = "multi_error",
         first_signal: int = 2,
+        channels: list[str] | None = None,
         backbone: Any = None,
         max_pool: Any = None,
     ) -> None:
@@ -63,6 +65,13 @@ class GradientBoostedTrees(nn.Module):
         del adjacency, window, backbone, max_pool  # trees see no graph and have no backbone
         self.num_joints, self.num_classes, self.in_features = num_joints, num_classes, in_features
         self.first_signal = first_signal
+        # Channel ablations: the signal channels the trees read (None: all of the schema's).
+        names = schema.FEATURE_NAMES[first_signal:]
+        unknown = sorted(set(channels or ()) - set(names))
+        if unknown:
+            raise ValueError(f"model.channels: unknown {unknown}; known: {list(names)}")
+        keep = [first_signal + names.index(c) for c in channels] if channels else None
+        self.register_buffer("channel_index", torch.tensor(keep if keep else [], dtype=torch.long))
         self.params = {
             "learning_rate": learning_rate,
             "num_leaves": num_leaves,
@@ -81,6 +90,8 @@ class GradientBoostedTrees(nn.Module):
 
     def features(self, x: torch.Tensor) -> np.ndarray:
         """``[B, W, N, F]`` -> ``[B, N * S * 7]`` float32."""
+        if self.channel_index.numel():
+            x = torch.cat([x[..., : self.first_signal], x[..., self.channel_index]], dim=-1)
         with torch.no_grad():
             stats = window_statistics(x.float(), self.first_signal)
         return stats.flatten(1).cpu().numpy()

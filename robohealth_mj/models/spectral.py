@@ -13,6 +13,8 @@ import math
 import torch
 from torch import nn
 
+from robohealth_mj import schema
+
 NUM_SPECTRAL = 5
 
 
@@ -20,8 +22,10 @@ class SpectralFeatures(nn.Module):
     def __init__(
         self,
         window: int,
-        vib_index: int = 5,
-        acc_indices: tuple[int, int, int] = (6, 7, 8),
+        vib_index: int = schema.feature_index("vib"),
+        acc_indices: tuple[int, ...] = tuple(
+            schema.feature_index(a) for a in ("acc_x", "acc_y", "acc_z")
+        ),
         high_band: float = 0.5,
     ) -> None:
         super().__init__()

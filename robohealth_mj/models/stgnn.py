@@ -13,6 +13,7 @@ from __future__ import annotations
 import torch
 from torch import nn
 
+from robohealth_mj import schema
 from robohealth_mj.models.adjacency import AdjacencyBuilder
 from robohealth_mj.models.backbone import GraphConvFactory, WindowBackbone
 from robohealth_mj.models.heads import (
@@ -46,7 +47,7 @@ class STGNN(nn.Module):
         spectral_features: bool = False,
         anomaly_head: bool = False,
         severity_head: bool = False,
-        pos_index: int = 2,
+        pos_index: int = schema.feature_index("pos"),
     ) -> None:
         super().__init__()
         n = adjacency.shape[0]

@@ -1,6 +1,6 @@
 """Exporting a checkpoint to a self-contained ONNX model.
 
-The model takes *raw* schema windows ``x: float32[B, W, 12, 9]``: the graph transform (the
+The model takes *raw* schema windows ``x: float32[B, W, 12, F]``: the graph transform (the
 harness mixing, when the model was trained under it) and the normalisation are inside the graph,
 so a deployment feeds sensor readings as they arrive. Metadata carries everything the runtime
 checks: node order, feature names, window, label table, schema version, fingerprints.
@@ -48,9 +48,10 @@ class RawInput(nn.Module):
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         if self.mix:
             j = schema.N_JOINTS
-            mixed = torch.einsum("jm,bwjc->bwmc", self.coupling, x[..., j:, 5:9])
+            sensor = schema.SENSOR_CHANNELS
+            mixed = torch.einsum("jm,bwjc->bwmc", self.coupling, x[..., j:, sensor])
             m = self.coupling.shape[1]
-            head = torch.zeros(*x.shape[:2], m, 5, dtype=x.dtype, device=x.device)
+            head = torch.zeros(*x.shape[:2], m, sensor.start, dtype=x.dtype, device=x.device)
             head[..., 1] = 1.0  # is_sensor; joint-state channels stay zero
             x = torch.cat([x[..., :j, :], torch.cat([head, mixed], dim=-1)], dim=-2)
         return (x - self.mean) / self.std
@@ -65,7 +66,7 @@ def file_fingerprint(path: Path | str) -> str:
 
 
 def heldout_windows(ckpt: dict[str, Any], data: str | list[str] | None, count: int) -> torch.Tensor:
-    """Up to ``count`` raw windows ``[K, W, 12, 9]`` spread over a held-out recording."""
+    """Up to ``count`` raw windows ``[K, W, 12, F]`` spread over a held-out recording."""
     data = data or ckpt["config"].get("data", {}).get("evaluate", {}).get("heldout")
     if not data:
         raise ValueError("no held-out data for the parity check: pass data=PATH")

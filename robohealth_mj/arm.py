@@ -1,4 +1,6 @@
-"""The instrumented arm running the curriculum: physics in C, bookkeeping in NumPy.
+"""The instrumented arm running the curriculum: controller + sensor package + faults composed on
+the physics. It sits above ``sim/`` and ``faults/`` (faults use sim's model index; sim knows
+nothing of faults), so layers point one way. Physics in C, bookkeeping in NumPy.
 
 Each chunk of ticks is one ``mujoco.rollout`` call: the controller's commands for every physics
 step are computed up front (inverse dynamics at knots, interpolated), so no Python runs between
@@ -32,8 +34,12 @@ class TickChunk:
     pos: np.ndarray  # [n, 6] measured link angle
     vel: np.ndarray  # [n, 6]
     effort: np.ndarray  # [n, 6] torque the drive applies
+    pos_error: np.ndarray  # [n, 6] measured link angle minus the controller's target
+    effort_residual: np.ndarray  # [n, 6] drive torque minus the controller's model torque
     vib: np.ndarray  # [n, 6]
     acc: np.ndarray  # [n, 6, 3]
+    bands: np.ndarray  # [n, 6, 3] piezo sub-band RMS
+    kurtosis: np.ndarray  # [n, 6] piezo kurtosis over the tick
     true_pos: np.ndarray  # [n, 6] noise-free link angle
     reference: np.ndarray  # [n, 6]
     saturated_steps: np.ndarray  # [6] physics steps at the torque limit, per joint
@@ -120,7 +126,7 @@ class ArmSimulator:
         steps = n_ticks * self.tick_steps
         first = self.tick * self.tick_steps
         step_times = (first + np.arange(steps)) * self.dt
-        ctrl, ref_velocity = self._controls(visit, step_times)
+        ctrl, ref_velocity, model_torque = self._controls(visit, step_times)
         forces = self.faults.torques(self._interval, step_times, ref_velocity, self.model.nv)
         state0 = np.empty(self.nstate)
         mujoco.mj_getState(self.model, self.data, state0, mujoco.mjtState.mjSTATE_FULLPHYSICS)
@@ -134,24 +140,29 @@ class ArmSimulator:
         )
         state, sensordata = state[0], sensordata[0]
         self.tick += n_ticks
-        return self._readings(visit, state, sensordata)
+        at_tick = slice(self.tick_steps - 1, None, self.tick_steps)
+        return self._readings(visit, state, sensordata, model_torque[at_tick])
 
-    def _controls(self, visit: int, step_times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Commands and reference velocities for every physics step (inverse dynamics at knots
-        on a global grid, interpolated)."""
+    def _controls(
+        self, visit: int, step_times: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Commands, reference velocities and the controller's model torques for every physics
+        step (inverse dynamics at knots on a global grid, interpolated)."""
         knot_dt = self.controller.knot_dt
         k0 = int(np.floor(step_times[0] / knot_dt + 1e-9))
         k1 = int(np.ceil(step_times[-1] / knot_dt - 1e-9))
         knots = np.arange(k0, max(k1, k0 + 1) + 1) * knot_dt
         q, qd, qdd = self.curriculum.reference(visit, knots)
-        ctrl_knots, _ = self.controller.commands(q, qd, qdd)
+        ctrl_knots, torque_knots = self.controller.commands(q, qd, qdd)
 
         def per_step(values: np.ndarray) -> np.ndarray:
             return np.stack([np.interp(step_times, knots, values[:, j]) for j in range(6)], axis=1)
 
-        return per_step(ctrl_knots), per_step(qd)
+        return per_step(ctrl_knots), per_step(qd), per_step(torque_knots)
 
-    def _readings(self, visit: int, state: np.ndarray, sensordata: np.ndarray) -> TickChunk:
+    def _readings(
+        self, visit: int, state: np.ndarray, sensordata: np.ndarray, model_torque: np.ndarray
+    ) -> TickChunk:
         idx = self.index
         at_tick = slice(self.tick_steps - 1, None, self.tick_steps)
         qpos = state[at_tick, 1 : 1 + self.model.nq]
@@ -160,21 +171,30 @@ class ArmSimulator:
         true_pos = qpos[:, idx.motor_qpos] + qpos[:, idx.deflection_qpos]
         vel = qvel[:, idx.motor_dof] + qvel[:, idx.deflection_dof]
         effort_all = sensordata[:, idx.effort_sensor]
-        acc_mean, vib = self.sensors.process(sensordata[:, idx.acc_sensor], self.tick_steps)
-        noisy = self.sensors.add_noise(self.rng, true_pos, vel, effort_all[at_tick], vib, acc_mean)
-        readings = TickReadings(*noisy)
+        acc_mean, piezo = self.sensors.process(
+            sensordata[:, idx.acc_sensor], self.tick_steps, self.rng
+        )
+        pos, vel, effort, acc = self.sensors.add_noise(
+            self.rng, true_pos, vel, effort_all[at_tick], acc_mean
+        )
+        readings = TickReadings(pos, vel, effort, piezo.vib, acc, piezo.bands, piezo.kurtosis)
         self.faults.alter_readings(self._interval, readings)
         scenario = self._interval.scenario
+        reference = self.curriculum.position(visit, t)
         return TickChunk(
             t=t,
             visit=visit,
             pos=readings.pos,
             vel=readings.vel,
             effort=readings.effort,
+            pos_error=readings.pos - reference,
+            effort_residual=readings.effort - model_torque,
             vib=readings.vib,
             acc=readings.acc,
+            bands=readings.bands,
+            kurtosis=readings.kurtosis,
             true_pos=true_pos,
-            reference=self.curriculum.position(visit, t),
+            reference=reference,
             saturated_steps=(np.abs(effort_all) >= 0.999 * idx.torque_limit).sum(axis=0),
             contacts=int(self.data.ncon),
             fault=scenario.label if scenario is not None else FaultLabel(),

@@ -1,0 +1,33 @@
+"""Campaign reports: tables and figures from a directory of finished runs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from robohealth_mj.atomic import atomic_write_text
+from robohealth_mj.reporting.figures import figures
+from robohealth_mj.reporting.tables import (
+    aggregate,
+    collect,
+    markdown,
+    visibility_markdown,
+    write_csv,
+)
+
+__all__ = ["build_report"]
+
+
+def build_report(root: Path) -> tuple[str, list[Path]]:
+    runs = collect(root)
+    if not runs:
+        raise SystemExit(f"no finished runs (train_summary.json + eval_heldout.json) under {root}")
+    rows = aggregate(runs)
+    out = root / "report"
+    out.mkdir(parents=True, exist_ok=True)
+    text = markdown(rows) + "\n" + visibility_markdown(runs)
+    atomic_write_text(
+        out / "results.md",
+        f"# Results: {root}\n\n{len(runs)} runs; mean ± std over seeds.\n\n{text}",
+    )
+    atomic_write_text(out / "results.csv", write_csv(rows))
+    return text, figures(runs, rows, out)
