@@ -1,7 +1,7 @@
 # Two commands for a fresh machine (Python 3.11 is all it needs):
 #   make run    set up .venv and run the whole pipeline on the quick corpus: record, gate, train
 #               gbdt / mlp / anomaly_residual (structural graph), evaluate, print the results
-#               table (about 8 minutes on 2 cores)
+#               tables (about 9 minutes on 2 cores)
 #   make test   set up .venv and run the test suite
 PYTHON ?= python3
 VENV   := .venv

@@ -22,7 +22,7 @@ def main(cfg: DictConfig) -> None:
     result = export_checkpoint(cfg.ckpt, out, cfg.data, cfg.parity_windows)
     print(
         f"exported {result['metadata']['model_id']} -> {result['path']} "
-        f"(parity {result['parity_max_abs_error']:.2g} on {result['windows']} held-out windows)"
+        f"(parity {result['parity_error']:.2g} on {result['windows']} held-out windows)"
     )
 
 

@@ -5,7 +5,8 @@
     python -m robohealth_mj.train -m variant=mlp,stgnn_fixed seed=42,43,44    # a sweep
     python -m robohealth_mj.train -m +experiment=thesis_matrix                # the campaign
 
-A run whose held-out evaluation already exists is skipped, so a killed sweep can be relaunched.
+A run whose held-out evaluation already exists, made on the data the config names now, is
+skipped, so a killed sweep can be relaunched (a re-recorded corpus trains again).
 """
 
 from __future__ import annotations
@@ -17,13 +18,12 @@ from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
 from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
-from robohealth_mj.learn.trainer import CHECKPOINT, train_run
+from robohealth_mj.learn.trainer import CHECKPOINT, finished_on_current_data, train_run
 
 
 def run(cfg: DictConfig, out_dir: Path) -> dict:
-    done = out_dir / "eval_heldout.json"
-    if cfg.skip_done and done.is_file():
-        print(f"skip {out_dir}: evaluation exists")
+    if cfg.skip_done and finished_on_current_data(cfg, out_dir):
+        print(f"skip {out_dir}: evaluation on the current data exists")
         return {"skipped": True}
     summary = train_run(cfg, out_dir)
     results = {"train": summary}

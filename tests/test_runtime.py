@@ -75,7 +75,7 @@ def test_export_matches_pytorch_on_raw_windows_and_carries_metadata(deployed, gr
     assert meta["joints"] == list(schema.JOINT_NAMES)
     assert meta["data_fingerprint"] == ckpt["data_fingerprint"]
     assert len(meta["checkpoint_fingerprint"]) == 16 and meta["graph"] == graph
-    assert float(meta["parity_max_abs_error"]) <= 1e-4
+    assert float(meta["parity_error"]) <= 1e-4
     import onnxruntime as ort
 
     session = ort.InferenceSession(str(deployed[f"{graph}_onnx"]))

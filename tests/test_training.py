@@ -4,6 +4,7 @@ end-to-end train -> evaluate run on data the test records itself."""
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -225,6 +226,12 @@ def test_a_relaunched_campaign_skips_finished_runs(tiny_corpus, tmp_path):
     stamp = (tmp_path / "best.ckpt").stat().st_mtime_ns
     assert run(cfg, tmp_path) == {"skipped": True}
     assert (tmp_path / "best.ckpt").stat().st_mtime_ns == stamp
+    # the same paths holding other data (a re-recorded corpus): trained again, not skipped
+    other = tmp_path / "rerecorded"
+    shutil.copytree(tiny_corpus, other, ignore=shutil.ignore_patterns("*.cache.npz"))
+    shutil.copy(other / "heldout" / GRAPHS_FILE, other / "train_c" / GRAPHS_FILE)
+    again = run(_train_cfg(other, "variant=mlp", "trainer.epochs=1"), tmp_path)
+    assert "train" in again and (tmp_path / "best.ckpt").stat().st_mtime_ns != stamp
 
 
 def test_the_harness_trains_and_reports_the_coupling_correlation(tiny_corpus, tmp_path):

@@ -59,6 +59,33 @@ def expand_paths(patterns: list[str] | str) -> list[Path]:
     return list(dict.fromkeys(resolve_recordings(found)))
 
 
+def finished_on_current_data(cfg: DictConfig, out_dir: Path) -> bool:
+    """A run whose summary and held-out evaluation exist *and* were made on the data the config
+    names now (fingerprints agree). A re-recorded corpus keeps its paths and run ids, so the files'
+    existence alone would report stale numbers."""
+    import json
+
+    summary_path, eval_path = out_dir / "train_summary.json", out_dir / "eval_heldout.json"
+    if not (summary_path.is_file() and eval_path.is_file()):
+        return False
+    try:
+        summary = json.loads(summary_path.read_text())
+        evaluation = json.loads(eval_path.read_text())
+        heldout = (cfg.data.evaluate or {}).get("heldout")
+        fresh = (
+            summary.get("data_fingerprint")
+            == load_recordings(expand_paths(cfg.data.train)).fingerprint()
+        )
+        if heldout:
+            fresh &= (
+                evaluation.get("data_fingerprint")
+                == load_recordings(expand_paths(heldout)).fingerprint()
+            )
+    except (OSError, ValueError, KeyError):
+        return False
+    return bool(fresh)
+
+
 def metrics_of(pred: Predictions, target_moving: np.ndarray | None = None) -> dict[str, Any]:
     return compute_metrics(
         pred.class_logits.argmax(1),

@@ -107,7 +107,7 @@ def export_checkpoint(
         tmp.unlink(missing_ok=True)
         side_data.unlink(missing_ok=True)
         raise RuntimeError(
-            f"ONNX parity check failed: max |torch - onnxruntime| = {error:.3g} "
+            f"ONNX parity check failed: max |torch - onnxruntime| / (1 + |torch|) = {error:.3g} "
             f"> {PARITY_TOLERANCE} on {len(windows)} held-out windows"
         )
     fingerprint = file_fingerprint(ckpt_path)
@@ -122,13 +122,13 @@ def export_checkpoint(
         checkpoint_fingerprint=fingerprint,
         data_fingerprint=ckpt["data_fingerprint"],
         code_version=ckpt["code_version"],
-        parity_max_abs_error=f"{error:.3g}",
+        parity_error=f"{error:.3g}",
     )
     attach_metadata(tmp, out, metadata)  # writes one self-contained file
     side_data.unlink(missing_ok=True)
     return {
         "path": str(out),
-        "parity_max_abs_error": error,
+        "parity_error": error,
         "windows": len(windows),
         "metadata": metadata,
     }
