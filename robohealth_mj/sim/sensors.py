@@ -116,18 +116,15 @@ class SensorPackage:
         def per_tick(filtered: np.ndarray) -> np.ndarray:  # [ticks, tick_steps, 6, 3]
             return filtered.reshape(ticks, tick_steps, N_JOINTS, 3)
 
-        broad = per_tick(self.filters[0](piezo))
-        power = (broad**2).sum(axis=-1).mean(axis=1)  # [ticks, 6]
-        second = (broad**2).mean(axis=1)  # per axis [ticks, 6, 3]
-        fourth = (broad**4).mean(axis=1)
-        kurtosis = (fourth / np.maximum(second**2, 1e-30)).mean(axis=-1)
-        bands = np.stack(
-            [
-                np.sqrt((per_tick(f(piezo)) ** 2).sum(axis=-1).mean(axis=1))
-                for f in self.filters[1:]
-            ],
-            axis=-1,
-        )
+        square = np.square(per_tick(self.filters[0](piezo)))
+        second = square.mean(axis=1)  # per axis [ticks, 6, 3]
+        fourth = np.square(square).mean(axis=1)
+        power = second.sum(axis=-1)  # [ticks, 6]
+        kurtosis = (fourth / np.maximum(np.square(second), 1e-30)).mean(axis=-1)
+        band_power = [
+            np.square(per_tick(f(piezo))).mean(axis=1).sum(axis=-1) for f in self.filters[1:]
+        ]
+        bands = np.sqrt(np.stack(band_power, axis=-1))
         acc_mean = acc.reshape(ticks, tick_steps, N_JOINTS, 3).mean(axis=1)
         return acc_mean, PiezoTick(np.sqrt(power), bands, kurtosis)
 
