@@ -3,7 +3,8 @@
 # default since schema 2.0), W = 32, seeds 42-44, two lanes of one thread each: gbdt and the
 # headline anomaly_residual (30 epochs without early stopping: at 20 epochs its validation score
 # was still rising at the last epoch, and early stopping cuts the one-cycle schedule before its
-# low-rate end), the gbdt channel ablation and the 20-epoch headline; then the report and the ONNX
+# low-rate end), the gbdt channel ablation, the 20-epoch headline and the harness rows (seed 42);
+# then the report and the ONNX
 # export. Run from the repository root; about 80 min on 2 cores.
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
@@ -16,11 +17,13 @@ T="trainer.threads=1 trainer.progress=false"
     'model.channels=[pos,vel,effort,vib,acc_x,acc_y,acc_z]'
   $PY -m robohealth_mj.train variant=gbdt seed=42 $T out_dir=outputs/ablation_physics/gbdt_v1_plus_joint \
     'model.channels=[pos,vel,effort,pos_error,effort_residual,vib,acc_x,acc_y,acc_z]'
+  $PY -m robohealth_mj.train -m $C graph=harness variant=gbdt seed=42
   for s in 42 43 44; do
     $PY -m robohealth_mj.train variant=anomaly_residual seed=$s $T out_dir=outputs/ablation_physics/anomaly_e20_seed$s
   done
 ) &
 $PY -m robohealth_mj.train -m $C trainer.epochs=30 trainer.patience=30 variant=anomaly_residual seed=42,43,44
+$PY -m robohealth_mj.train -m $C trainer.epochs=30 trainer.patience=30 variant=anomaly_residual seed=42 graph=harness
 wait
 $PY -m robohealth_mj.report outputs/campaign_physics
 cp outputs/campaign_physics/report/* results/headline_physics/
