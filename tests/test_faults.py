@@ -22,18 +22,29 @@ from robohealth_mj.schema import JOINT_NAMES
 SECONDS = 8.0
 
 
-def _simulate(*overrides: str):
-    """Joint state ``[T, 6, 3]``, sensor readings ``[T, 6, 4]`` and labels of a short run."""
+def _run(*overrides: str, seconds: float = SECONDS) -> tuple[dict[str, np.ndarray], list]:
+    """Every per-tick array of a short run's chunks, concatenated, and the chunks' labels."""
     cfg = compose_config("record", ["seed=3", "session.progress=false", *overrides])
     sim = build_simulator(cfg)
-    chunks = list(sim.run(round(SECONDS / sim.tick_s)))
+    chunks = list(sim.run(round(seconds / sim.tick_s)))
+    arrays = {
+        name: np.concatenate([getattr(c, name) for c in chunks])
+        for name, value in vars(chunks[0]).items()
+        if isinstance(value, np.ndarray) and value.ndim
+    }
+    return arrays, [c.fault for c in chunks]
 
-    def cat(name: str) -> np.ndarray:
-        return np.concatenate([getattr(c, name) for c in chunks])
 
-    state = np.stack([cat("pos"), cat("vel"), cat("effort")], axis=-1)
-    sensor = np.concatenate([cat("vib")[:, :, None], cat("acc")], axis=-1)
-    return state, sensor, [c.fault for c in chunks]
+def _chunks(*overrides: str, seconds: float = SECONDS) -> dict[str, np.ndarray]:
+    return _run(*overrides, seconds=seconds)[0]
+
+
+def _simulate(*overrides: str):
+    """Joint state ``[T, 6, 3]``, sensor readings ``[T, 6, 4]`` and labels of a short run."""
+    a, labels = _run(*overrides)
+    state = np.stack([a["pos"], a["vel"], a["effort"]], axis=-1)
+    sensor = np.concatenate([a["vib"][:, :, None], a["acc"]], axis=-1)
+    return state, sensor, labels
 
 
 def _fixed(fault_class: str, joint: str, *extra: str) -> list[str]:
@@ -95,17 +106,6 @@ def test_physics_friction_raises_the_effort_of_the_target_drive():
     state, _, _ = _simulate(*_fixed("friction", "elbow", "faults.fault_model=physics", *moving))
     j = JOINT_NAMES.index("elbow")
     assert np.abs(state[:, j, 2]).mean() > np.abs(h_state[:, j, 2]).mean() + 2.0
-
-
-def _chunks(*overrides: str, seconds: float = SECONDS) -> dict[str, np.ndarray]:
-    cfg = compose_config("record", ["seed=3", "session.progress=false", *overrides])
-    sim = build_simulator(cfg)
-    chunks = list(sim.run(round(seconds / sim.tick_s)))
-    return {
-        k: np.concatenate([getattr(c, k) for c in chunks])
-        for k in vars(chunks[0])
-        if isinstance(getattr(chunks[0], k), np.ndarray) and getattr(chunks[0], k).ndim
-    }
 
 
 def test_torque_residual_is_near_zero_healthy_and_rises_by_the_added_friction(model):

@@ -6,6 +6,7 @@ One seed controls Python, NumPy, PyTorch (initialisation, batch order, dropout) 
 from __future__ import annotations
 
 import glob
+import json
 import math
 import random
 import time
@@ -63,8 +64,6 @@ def finished_on_current_data(cfg: DictConfig, out_dir: Path) -> bool:
     """A run whose summary and held-out evaluation exist *and* were made on the data the config
     names now (fingerprints agree). A re-recorded corpus keeps its paths and run ids, so the files'
     existence alone would report stale numbers."""
-    import json
-
     summary_path, eval_path = out_dir / "train_summary.json", out_dir / "eval_heldout.json"
     if not (summary_path.is_file() and eval_path.is_file()):
         return False

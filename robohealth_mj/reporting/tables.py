@@ -65,19 +65,24 @@ def _fmt(stat: tuple[float, float, int]) -> str:
     return "—" if n == 0 else f"{mean:.3f} ± {std:.3f}"
 
 
-def aggregate(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
+def grouped(runs: list[dict[str, Any]]) -> list[tuple[tuple[str, str, int], list[dict]]]:
+    """Runs grouped by (graph, variant, window): structural graph first, variants in the
+    thesis's order."""
     groups: dict[tuple, list] = defaultdict(list)
     for r in runs:
         groups[(r["graph"], r["variant"], r["window"])].append(r)
 
-    def order(key):
+    def order(key: tuple[str, str, int]) -> tuple:
         graph, variant, window = key
         rank = VARIANT_ORDER.index(variant) if variant in VARIANT_ORDER else 99
         return (graph != "structural", graph, window, rank)
 
+    return [(key, groups[key]) for key in sorted(groups, key=order)]
+
+
+def aggregate(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     rows = []
-    for key in sorted(groups, key=order):
-        members = groups[key]
+    for key, members in grouped(runs):
         row: dict[str, Any] = {
             "graph": key[0],
             "variant": key[1],
@@ -174,11 +179,7 @@ def visibility_markdown(runs: list[dict[str, Any]]) -> str:
         "| graph | variant | W | " + " | ".join(head) + " |",
         "|---|---|---|" + "---|" * len(head),
     ]
-    groups: dict[tuple, list] = defaultdict(list)
-    for r in runs:
-        groups[(r["graph"], r["variant"], r["window"])].append(r)
-    for key in sorted(groups, key=lambda k: (k[0] != "structural", k[0], k[2], _rank(k[1]))):
-        members = groups[key]
+    for key, members in grouped(runs):
         cells = [
             _fmt(_mean_std([_held_out(m, "per_class", c, "recall") for m in members]))
             for c in faults
@@ -189,7 +190,3 @@ def visibility_markdown(runs: list[dict[str, Any]]) -> str:
         ]
         out.append(f"| {key[0]} | {key[1]} | {key[2]} | " + " | ".join(cells) + " |")
     return "\n".join([*out, ""])
-
-
-def _rank(variant: str) -> int:
-    return VARIANT_ORDER.index(variant) if variant in VARIANT_ORDER else 99
