@@ -5,11 +5,18 @@
     python -m robohealth_mj.bench train [--data 'outputs/corpus/quick/train_*'] [--window 32]
     python -m robohealth_mj.bench train --headline [OVERRIDE ...]
     python -m robohealth_mj.bench infer [--data outputs/corpus/quick/heldout_seed900] [--window 32]
+    python -m robohealth_mj.bench infer --model results/headline_physics/<model>.onnx
+    python -m robohealth_mj.bench streams [--model M] [--streams 1000] [--seconds 30]
+    python -m robohealth_mj.bench soak [--model M] [--streams 1000] [--seconds 60]
 
 ``sim`` measures, in one run, the raw ``mj_step`` rate of the scene and the recorder's throughput
 (physics + control + sensor synthesis + JSONL writing), and reports their ratio. ``train
 --headline`` runs the headline training (``anomaly_residual``, W = 32, standard corpus) end to end
-and reports the time to its best checkpoint, data loading included.
+and reports the time to its best checkpoint, data loading included. ``streams`` replays real
+recordings on many interleaved 20 Hz streams through the fleet runtime: the largest stream count
+whose per-tick p99 fits the 50 ms tick (search), then a paced run at ``--streams`` with its CPU
+share, and the windowed path beside the incremental one. ``soak`` runs a fleet under bad input
+(see ``robohealth_mj/benchmarks/soak.py``) and checks every flagged row and the memory.
 """
 
 from __future__ import annotations
@@ -45,8 +52,27 @@ def main(argv: list[str] | None = None) -> None:
     infer.add_argument("--variants", nargs="+", default=None, help="default: every network")
     infer.add_argument("--window", type=int, default=32)
     infer.add_argument("--batch", type=int, default=256)
+    infer.add_argument("--model", default=None, help="an exported model (instead of --variants)")
+    headline = "results/headline_physics/anomaly_residual_w32_seed42.onnx"
+    streams = sub.add_parser("streams", help="fleet load test: sustained 20 Hz streams")
+    soak = sub.add_parser("soak", help="fleet under bad input: flags, tick budget, memory")
+    for p, seconds in ((streams, 30.0), (soak, 60.0)):
+        p.add_argument("--model", default=headline)
+        p.add_argument("--data", nargs="+", default=["outputs/corpus/standard/heldout_seed900"])
+        p.add_argument("--streams", type=int, default=1000)
+        p.add_argument("--seconds", type=float, default=seconds, help="paced run length")
+        p.add_argument("--shards", type=int, default=2, help="threads the fleet step uses")
+    streams.add_argument("--no-search", action="store_true", help="skip the stream-count search")
     args = parser.parse_args(argv)
-    if args.what == "infer":
+    if args.what in ("streams", "soak"):
+        from robohealth_mj.benchmarks.fleet import bench_fleet, bench_soak
+
+        (bench_fleet if args.what == "streams" else bench_soak)(args)
+    elif args.what == "infer" and args.model:
+        from robohealth_mj.benchmarks.infer import bench_deployed
+
+        bench_deployed(args.model, args.data, args.batch)
+    elif args.what == "infer":
         from robohealth_mj.benchmarks.infer import bench_infer
         from robohealth_mj.models import NETWORK_VARIANTS
 

@@ -26,7 +26,7 @@ def load_cli_config(name: str, argv: Sequence[str], prog: str) -> DictConfig:
     apps (``model=`` there names a file, not the training ``model`` config group)."""
     cfg = OmegaConf.load(CONF_DIR / f"{name}.yaml")
     keys = [a.split("=", 1)[0] for a in argv]
-    unknown = [k for k in keys if k not in cfg]
+    unknown = [k for k in keys if k.split(".")[0] not in cfg]
     if unknown or any("=" not in a for a in argv):
         raise SystemExit(
             f"usage: python -m {prog} key=value ... (keys: {', '.join(cfg)}); "

@@ -19,15 +19,9 @@ from robohealth_mj.schema import SchemaError
 
 
 def resolve(paths: list[str]) -> list[Path]:
-    files = []
-    for raw in paths:
-        p = Path(raw)
-        if p.is_dir():
-            p = p / "graphs.jsonl"
-        if not p.is_file():
-            raise FileNotFoundError(f"no recording at {raw}")
-        files.append(p)
-    return files
+    from robohealth_mj.data.arrays import resolve_recordings
+
+    return resolve_recordings(paths)
 
 
 def _summarize(args: argparse.Namespace) -> int:

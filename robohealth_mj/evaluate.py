@@ -11,6 +11,7 @@ from pathlib import Path
 import hydra
 from omegaconf import DictConfig
 
+from robohealth_mj.errors import one_line_errors
 from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 
 
@@ -18,7 +19,8 @@ from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 def main(cfg: DictConfig) -> None:
     if not cfg.ckpt or not cfg.data:
         raise SystemExit("usage: python -m robohealth_mj.evaluate ckpt=PATH data=PATH [out=PREFIX]")
-    result = evaluate_checkpoint(cfg.ckpt, cfg.data, cfg.device)
+    with one_line_errors("evaluate"):
+        result = evaluate_checkpoint(cfg.ckpt, cfg.data, cfg.device)
     prefix = cfg.out or Path(cfg.ckpt).parent / f"eval_{Path(str(cfg.data)).stem}"
     json_path, _ = write_evaluation(result, prefix)
     m = result["metrics"]

@@ -11,6 +11,7 @@ from pathlib import Path
 import hydra
 from omegaconf import DictConfig
 
+from robohealth_mj.errors import one_line_errors
 from robohealth_mj.runtime.export import export_checkpoint
 
 
@@ -19,10 +20,14 @@ def main(cfg: DictConfig) -> None:
     if not cfg.ckpt:
         raise SystemExit("usage: python -m robohealth_mj.export ckpt=PATH [out=model.onnx]")
     out = cfg.out or Path(cfg.ckpt).with_name("model.onnx")
-    result = export_checkpoint(cfg.ckpt, out, cfg.data, cfg.parity_windows)
+    with one_line_errors("export"):
+        result = export_checkpoint(cfg.ckpt, out, cfg.data, cfg.parity_windows)
+    incremental = result["metadata"].get("incremental_parity_error")
     print(
         f"exported {result['metadata']['model_id']} -> {result['path']} "
-        f"(parity {result['parity_error']:.2g} on {result['windows']} held-out windows)"
+        f"(parity {result['parity_error']:.2g} on {result['windows']} held-out windows"
+        + (f"; incremental form parity {incremental}" if incremental else "; windowed only")
+        + ")"
     )
 
 

@@ -4,55 +4,69 @@
     python -m robohealth_mj.monitor model=model.onnx source=replay file=graphs.jsonl speed=10
     python -m robohealth_mj.monitor model=model.onnx source=replay file=... evaluate=true
 
-Prints each change of diagnosis. With ``evaluate=true`` it also writes on-line accuracy,
-localisation accuracy, false-alarm rate and detection latency per fault class and severity.
+Prints each change of diagnosis and every alarm raised or cleared (debouncing and hysteresis:
+``alarm.raise_after``, ``alarm.clear_after``, ``alarm.min_confidence``, ``alarm.clear_confidence``;
+see ``conf/monitor.yaml``). With ``evaluate=true`` it also writes on-line accuracy, localisation
+accuracy, alarm detection rate, false alarms (per settled healthy tick and per hour) and debounced
+detection latency to class and joint, per fault class and severity.
 """
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from collections.abc import Iterator
+from contextlib import ExitStack
 from datetime import datetime
 from pathlib import Path
 
 from omegaconf import DictConfig
 
-from robohealth_mj.atomic import atomic_write_json
+from robohealth_mj.atomic import atomic_write_json, atomic_write_text
+from robohealth_mj.bags.reader import is_bag, read_bag_samples
+from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.bags.writer import BagWriter
 from robohealth_mj.config import compose_config, load_cli_config
+from robohealth_mj.errors import InputError, one_line_errors
+from robohealth_mj.reporting.online import online_markdown
+from robohealth_mj.runtime.alarms import AlarmPolicy
+from robohealth_mj.runtime.export import read_metadata
+from robohealth_mj.runtime.fleet import freeze_startup_heap
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
-from robohealth_mj.schema import FaultLabel, validate_sample
+from robohealth_mj.schema import FaultLabel, GraphSample, SchemaError, validate_sample
 
 
-def sim_stream(overrides: list[str], duration_s: float) -> Iterator[tuple[float, str]]:
-    """GraphSample lines straight from the simulator (with its fault schedule)."""
-    from robohealth_mj.recorder import build_simulator, chunk_lines
+def sim_stream(
+    overrides: list[str], duration_s: float
+) -> Iterator[tuple[float, GraphSample, FaultLabel]]:
+    """GraphSamples straight from the simulator (with its fault schedule)."""
+    from robohealth_mj.recorder import build_simulator, chunk_features, segment_info
 
     sim = build_simulator(compose_config("record", ["session.progress=false", *overrides]))
     for chunk in sim.run(round(duration_s / sim.tick_s)):
-        yield from zip(chunk.t.tolist(), chunk_lines(sim, chunk, "sim"), strict=True)
+        first, x, segment = sim.tick - len(chunk.t), chunk_features(chunk), segment_info(sim, chunk)
+        for k, t in enumerate(chunk.t.tolist()):
+            sample = GraphSample("sim", first + k, t, x[k].astype("float32"), chunk.fault, segment)
+            yield t, sample, chunk.fault
 
 
-def replay_stream(path: str) -> Iterator[tuple[float, str]]:
+def replay_stream(path: str) -> Iterator[tuple[float, str | GraphSample, FaultLabel | None]]:
+    """``(t, sample, truth)`` per recorded sample: a graphs.jsonl's lines (a line that does not
+    parse goes to the runtime as it is, which flags it) or a bag's assembled samples."""
+    if is_bag(path):
+        for sample in read_bag_samples(path):
+            yield sample.t, sample, sample.fault
+        return
     with open(path, encoding="utf-8") as handle:
-        for line in handle:
+        for number, line in enumerate(handle, start=1):
             try:
-                import json
-
-                t = float(json.loads(line).get("t", 0.0))
-            except (ValueError, AttributeError):
-                t = 0.0  # the runtime will flag the line itself
-            yield t, line
-
-
-def truth_of(line: str) -> FaultLabel | None:
-    try:
-        import json
-
-        return validate_sample(json.loads(line)).fault
-    except Exception:
-        return None
+                sample = validate_sample(json.loads(line), source=path, line=number)
+            except (ValueError, SchemaError):
+                yield 0.0, line, None
+                continue
+            yield sample.t, sample, sample.fault
 
 
 def describe(d: HealthDiagnosis) -> str:
@@ -74,56 +88,96 @@ def main(argv: list[str] | None = None) -> dict | None:
 
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     cfg = load_config(sys.argv[1:] if argv is None else argv)
-    runtime = ModelRuntime(cfg.model)
+    try:
+        policy = AlarmPolicy(**cfg.alarm)
+    except (TypeError, ValueError) as exc:
+        raise SystemExit(f"conf/monitor.yaml alarm: {exc}") from None
+    with one_line_errors("monitor"):
+        return _monitor(cfg, policy)
+
+
+def _monitor(cfg: DictConfig, policy: AlarmPolicy) -> dict | None:
+    if cfg.model:
+        read_metadata(cfg.model)  # a model named but unusable is the user's to fix
+    runtime = ModelRuntime(
+        cfg.model, threads=cfg.threads, alarm=policy, incremental=cfg.incremental
+    )
     if cfg.source == "sim":
         stream = sim_stream(list(cfg.sim_overrides), cfg.duration_s)
     elif cfg.source == "replay":
-        if not cfg.file or not Path(cfg.file).is_file():
-            raise SystemExit(f"source=replay needs file=PATH to a graphs.jsonl (got {cfg.file})")
+        if not cfg.file or not (Path(cfg.file).is_file() or is_bag(cfg.file)):
+            raise FileNotFoundError(
+                f"source=replay needs file=PATH to a graphs.jsonl or a bag directory "
+                f"(got {cfg.file})"
+            )
         stream = replay_stream(cfg.file)
     else:
-        raise SystemExit(f"source must be sim or replay, got {cfg.source!r}")
-    evaluator = OnlineEvaluator() if cfg.evaluate else None
+        raise InputError(f"source must be sim or replay, got {cfg.source!r}")
+    freeze_startup_heap()
+    settle = runtime.window + policy.clear_after
+    evaluator = OnlineEvaluator(settle_ticks=settle) if cfg.evaluate else None
     last, started, t0 = None, time.perf_counter(), None
-    for t, line in stream:
-        if cfg.speed and t0 is not None:
-            delay = (t - t0) / cfg.speed - (time.perf_counter() - started)
-            if delay > 0:
-                time.sleep(delay)
-        t0 = t if t0 is None else t0
-        d = runtime.process(cfg.stream_id, line)
-        truth = truth_of(line)
-        if evaluator is not None and truth is not None:
-            evaluator.update(truth, d)
-        shown = describe(d)
-        if shown.split(" (")[0] != (last or "").split(" (")[0]:
-            label = (
-                ""
-                if truth is None
-                else (
-                    f"   [truth: {truth.fault_class} @ {truth.joint} sev {truth.severity:g}]"
-                    if truth.active
-                    else "   [truth: healthy]"
-                )
-            )
+    with ExitStack() as stack:
+        bag = stack.enter_context(BagWriter(cfg.bag_out)) if cfg.bag_out else None
+        for t, sample, truth in stream:
+            if cfg.speed and t0 is not None:
+                delay = (t - t0) / cfg.speed - (time.perf_counter() - started)
+                if delay > 0:
+                    time.sleep(delay)
+            t0 = t if t0 is None else t0
+            d = runtime.process(cfg.stream_id, sample)
+            if bag is not None and isinstance(sample, GraphSample):
+                bag.write_sample(sample)
+                bag.write_diagnosis(d, runtime.fleet.classes, runtime.fleet.joints)
+            if evaluator is not None and truth is not None:
+                evaluator.update(truth, d)
             if not cfg.quiet:
-                print(f"t={t:8.2f}s {cfg.stream_id}: {shown}{label}", flush=True)
-            last = shown
-    if evaluator is not None:
-        result = {"model": runtime.describe(), "source": cfg.source, **evaluator.result()}
-        stamp = datetime.now().strftime("%Y-%m-%d_%H-%M-%S")
-        out = Path(cfg.out or Path("outputs/monitor") / stamp / "online_eval.json")
-        atomic_write_json(out, result)
-        lat = result["detection_latency"]
-        print(
-            f"on-line accuracy {_num(result['online_accuracy'])}  localisation "
-            f"{_num(result['localisation_accuracy'])}  false alarms "
-            f"{_num(result['false_alarm_rate'])}  class latency "
-            f"{_num(lat['class_latency_s_mean'])} s  joint latency "
-            f"{_num(lat['joint_latency_s_mean'])} s over {result['episodes']} episodes -> {out}"
+                last = _print(cfg.stream_id, t, d, truth, last)
+    if cfg.bag_out:
+        print(f"replayed topics and {BagTopics.load().health_diagnosis} -> {cfg.bag_out}")
+    if evaluator is None:
+        return None
+    result = {
+        "model": runtime.describe(),
+        "source": cfg.source,
+        "file": cfg.file,
+        "alarm_policy": dict(cfg.alarm),
+        **evaluator.result(),
+    }
+    stamp = datetime.now().strftime("%Y-%m-%d_%H-%M-%S")
+    out = Path(cfg.out or Path("outputs/monitor") / stamp / "online_eval.json")
+    atomic_write_json(out, result)
+    atomic_write_text(out.with_suffix(".md"), online_markdown(result))
+    alarms = result["alarms"]
+    print(
+        f"on-line accuracy {_num(result['online_accuracy'])}  localisation "
+        f"{_num(result['localisation_accuracy'])} | alarms: detected "
+        f"{alarms['detected']}/{alarms['episodes']} episodes, false alarms "
+        f"{_num(result['false_alarm_rate'])} of settled healthy ticks "
+        f"({_num(result['false_alarms_per_hour'])}/h), latency to class "
+        f"{_num(alarms['class_latency_s_median'])} s, to joint "
+        f"{_num(alarms['joint_latency_s_median'])} s (medians) -> {out}"
+    )
+    return result
+
+
+def _print(stream_id: str, t: float, d: HealthDiagnosis, truth, last: str | None) -> str | None:
+    """Print an alarm raised or cleared, and each change of diagnosis with the truth."""
+    if d.alarm in ("raised", "cleared"):
+        where = f" @ {d.alarm_joint}" if d.alarm_joint else ""
+        print(f"t={t:8.2f}s {stream_id}: ALARM {d.alarm.upper()} {d.alarm_class or ''}{where}")
+    shown = describe(d)
+    if shown.split(" (")[0] == (last or "").split(" (")[0]:
+        return last
+    label = ""
+    if truth is not None:
+        label = (
+            f"   [truth: {truth.fault_class} @ {truth.joint} sev {truth.severity:g}]"
+            if truth.active
+            else "   [truth: healthy]"
         )
-        return result
-    return None
+    print(f"t={t:8.2f}s {stream_id}: {shown}{label}", flush=True)
+    return shown
 
 
 def _num(value: float | None) -> str:

@@ -21,6 +21,8 @@ import numpy as np
 from omegaconf import DictConfig
 
 from robohealth_mj.config import compose_config, load_cli_config
+from robohealth_mj.errors import one_line_errors
+from robohealth_mj.runtime.export import read_metadata
 
 
 def load_config(argv: list[str]) -> DictConfig:
@@ -108,7 +110,10 @@ def render_episode(cfg: DictConfig) -> list:
 
 def main(argv: list[str] | None = None) -> None:
     cfg = load_config(sys.argv[1:] if argv is None else argv)
-    frames = render_episode(cfg)
+    with one_line_errors("render"):
+        if cfg.model:
+            read_metadata(cfg.model)  # a bad model file is the user's to fix, not a fallback
+        frames = render_episode(cfg)
     print(
         f"rendered {len(frames)} frames ({cfg.width}x{cfg.height}, {cfg.fps} fps)"
         + (f" -> {cfg.out}" if cfg.out else "")

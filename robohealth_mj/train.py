@@ -17,6 +17,7 @@ import hydra
 from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
+from robohealth_mj.errors import one_line_errors
 from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 from robohealth_mj.learn.trainer import CHECKPOINT, finished_on_current_data, train_run
 
@@ -45,7 +46,8 @@ def run(cfg: DictConfig, out_dir: Path) -> dict:
 
 @hydra.main(config_path="../conf", config_name="train", version_base="1.3")
 def main(cfg: DictConfig) -> None:
-    run(cfg, Path(cfg.out_dir or HydraConfig.get().runtime.output_dir))
+    with one_line_errors("train"):
+        run(cfg, Path(cfg.out_dir or HydraConfig.get().runtime.output_dir))
 
 
 if __name__ == "__main__":

@@ -4,64 +4,22 @@ input, the no-model fallback, interleaved streams and on-line detection latency.
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
 
 from robohealth_mj import schema
-from robohealth_mj.config import compose_config
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.windows import make_windows
 from robohealth_mj.learn.checkpoint import load_checkpoint, model_from_checkpoint
 from robohealth_mj.monitor import main as monitor_main
-from robohealth_mj.recorder import GRAPHS_FILE, record_session
 from robohealth_mj.runtime.export import RawInput, export_checkpoint, read_metadata
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 from robohealth_mj.schema import FaultLabel
-from robohealth_mj.train import run
 
 F = schema.N_FEATURES
-
-FAST = [
-    "session.progress=false",
-    "faults.schedule.fault_s=1.0",
-    "faults.schedule.healthy_s=1.0",
-    "faults.schedule.severities=[0.9]",
-    "faults.schedule.joints=[elbow,wrist_1]",
-    "session.passes=1",
-]
-
-
-@pytest.fixture(scope="module")
-def deployed(tmp_path_factory) -> dict[str, Path]:
-    """A tiny trained model (structural and harness) exported to ONNX, and its held-out data."""
-    root = tmp_path_factory.mktemp("deploy")
-    for name, seed in (("train_a", 1), ("train_b", 2), ("train_c", 3), ("heldout", 4)):
-        record_session(compose_config("record", [*FAST, f"seed={seed}"]), root / name)
-    paths = {"root": root, "heldout": root / "heldout" / GRAPHS_FILE}
-    for graph in ("structural", "harness"):
-        cfg = compose_config(
-            "train",
-            [
-                f"data.train=[{root}/train_*]",
-                f"data.evaluate.heldout={root}/heldout",
-                "data.evaluate.probe=null",
-                "trainer.epochs=1",
-                "trainer.progress=false",
-                "model.hidden=8",
-                "window=8",
-                "variant=anomaly_residual",
-                f"graph={graph}",
-            ],
-        )
-        run(cfg, root / graph)
-        paths[f"{graph}_ckpt"] = root / graph / "best.ckpt"
-        result = export_checkpoint(root / graph / "best.ckpt", root / graph / "model.onnx")
-        paths[f"{graph}_onnx"] = Path(result["path"])
-    return paths
 
 
 @pytest.mark.parametrize("graph", ["structural", "harness"])
@@ -229,14 +187,14 @@ def test_online_evaluation_measures_detection_latency_on_a_scripted_stream():
     assert jam_lat["class_latency_s_mean"] == pytest.approx(0.25)
     drift_lat = r["detection_latency_by_class_and_severity"]["sensor_drift@0.3"]
     assert drift_lat["class_detected"] == 0 and drift_lat["class_latency_ticks_mean"] is None
-    assert r["false_alarm_rate"] == pytest.approx(1 / 7)
+    assert r["false_positive_rate"] == pytest.approx(1 / 7)
     assert r["localisation_accuracy"] == pytest.approx(3 / 16)
     decided = len(script) - 3
     # right class: 4 healthy, 2 + 3 jam (joint aside), 2 healthy
     assert r["online_accuracy"] == pytest.approx((4 + 2 + 3 + 2) / decided)
 
 
-def test_monitor_replays_and_evaluates(deployed, tmp_path, capsys):
+def test_monitor_replays_and_evaluates_with_its_alarm_settings(deployed, tmp_path, capsys):
     out = tmp_path / "online.json"
     result = monitor_main(
         [
@@ -244,9 +202,14 @@ def test_monitor_replays_and_evaluates(deployed, tmp_path, capsys):
             "source=replay",
             f"file={deployed['heldout']}",
             "evaluate=true",
+            "alarm.raise_after=2",
+            "alarm.min_confidence=0.3",
             f"out={out}",
         ]
     )
     assert json.loads(out.read_text())["episodes"] == result["episodes"] > 0
+    assert result["alarm_policy"]["raise_after"] == 2
+    assert result["alarms"]["episodes"] == result["episodes"]
+    assert "| episodes of |" in out.with_suffix(".md").read_text()
     printed = capsys.readouterr().out
-    assert "arm1:" in printed and "[truth:" in printed and "on-line accuracy" in printed
+    assert "arm1:" in printed and "[truth:" in printed and "alarms: detected" in printed

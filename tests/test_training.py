@@ -21,7 +21,7 @@ from robohealth_mj.data.windows import (
     run_aware_split,
     target_joint_moved,
 )
-from robohealth_mj.learn.checkpoint import load_checkpoint
+from robohealth_mj.learn.checkpoint import checkpoint_digest, load_checkpoint
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
 from robohealth_mj.recorder import GRAPHS_FILE, record_session
 from robohealth_mj.train import run
@@ -138,18 +138,10 @@ def _record(root: Path, overrides: list[str], seeds: dict[str, int]) -> Path:
 
 
 @pytest.fixture(scope="module")
-def tiny_corpus(tmp_path_factory) -> Path:
+def tiny_corpus(tmp_path_factory, fast_session) -> Path:
     """Three short training sessions and a held-out one, each covering every fault class."""
     root = tmp_path_factory.mktemp("corpus")
-    fast = [
-        "session.progress=false",
-        "faults.schedule.fault_s=1.0",
-        "faults.schedule.healthy_s=1.0",
-        "faults.schedule.severities=[0.9]",
-        "faults.schedule.joints=[elbow,wrist_1]",
-        "session.passes=1",
-    ]
-    return _record(root, fast, {"train_a": 1, "train_b": 2, "train_c": 3, "heldout": 4})
+    return _record(root, fast_session, {"train_a": 1, "train_b": 2, "train_c": 3, "heldout": 4})
 
 
 def _train_cfg(corpus: Path, *extra: str, network: bool = True):
@@ -210,12 +202,18 @@ def test_evaluation_refuses_a_checkpoint_with_another_topology(tiny_corpus, tmp_
     run(_train_cfg(tiny_corpus, "variant=mlp", "trainer.epochs=1"), tmp_path)
     ckpt = torch.load(tmp_path / "best.ckpt", weights_only=True)
     ckpt["schema"]["node_names"] = ckpt["schema"]["node_names"][::-1]
+    ckpt["sha256"] = checkpoint_digest(ckpt)  # a sound file, written for another graph
     torch.save(ckpt, tmp_path / "other.ckpt")
     with pytest.raises(ValueError, match="node order"):
         evaluate_checkpoint(tmp_path / "other.ckpt", str(tiny_corpus / "heldout"))
     ckpt["schema"]["node_names"] = list(schema.NODE_NAMES)
     ckpt["schema"]["edges"] = ckpt["schema"]["edges"][2:]
+    ckpt["sha256"] = checkpoint_digest(ckpt)
     torch.save(ckpt, tmp_path / "other.ckpt")
+    with pytest.raises(ValueError, match="altered"):
+        ckpt["window"] += 1  # the same file edited afterwards
+        torch.save(ckpt, tmp_path / "edited.ckpt")
+        evaluate_checkpoint(tmp_path / "edited.ckpt", str(tiny_corpus / "heldout"))
     with pytest.raises(ValueError, match="topology"):
         evaluate_checkpoint(tmp_path / "other.ckpt", str(tiny_corpus / "heldout"))
 

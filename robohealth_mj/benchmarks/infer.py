@@ -1,57 +1,15 @@
-"""Deployment benchmark: latency, batched throughput, FLOP share and sustained 20 Hz streams."""
+"""Deployment benchmark: batch-1 latency, batched throughput and FLOP share, per variant (fresh
+weights) or of one exported model (``--model``: the headline). Stream capacity: ``bench
+streams``."""
 
 from __future__ import annotations
 
 import os
 import tempfile
-import time
 
 import numpy as np
 
 from robohealth_mj.benchmarks.common import fresh_variant, latency_ms, matmul_rate
-
-
-def sustained_streams(
-    model_path: str,
-    window_x: np.ndarray,
-    tick_budget_s: float = 0.05,
-    start: int = 32,
-    limit: int = 8192,
-) -> tuple[int, dict[int, float]]:
-    """Largest number of concurrent streams whose per-tick work (validate + buffer one sample per
-    stream, one batched inference) fits in a 20 Hz tick, doubling N until it does not."""
-    from robohealth_mj.data.jsonl import format_line
-    from robohealth_mj.runtime.runtime import ModelRuntime
-    from robohealth_mj.schema import FaultLabel
-
-    segment = {"index": 0, "family": "whole_arm", "speed_scale": 1.0, "payload_scale": 1.0}
-    w = window_x.shape[0]
-    lines = [
-        format_line(
-            "bench", k, 0.05 * (k + 1), window_x[k % w].astype(float), FaultLabel(), segment
-        )
-        for k in range(w + 12)
-    ]
-    timings: dict[int, float] = {}
-    best, n = 0, start
-    while n <= limit:
-        runtime = ModelRuntime(model_path)
-        for k in range(w):  # fill every stream's window
-            for s_id in range(n):
-                runtime.submit(str(s_id), lines[k])
-            runtime.tick()
-        per_tick = []
-        for k in range(w, w + 10):
-            start_t = time.perf_counter()
-            for s_id in range(n):
-                runtime.submit(str(s_id), lines[k])
-            runtime.tick()
-            per_tick.append(time.perf_counter() - start_t)
-        timings[n] = float(np.median(per_tick))
-        if timings[n] > tick_budget_s:
-            break
-        best, n = n, n * 2
-    return best, timings
 
 
 def bench_infer(data: list[str], variants: list[str], window: int, batch: int) -> list[dict]:
@@ -119,7 +77,6 @@ def bench_infer(data: list[str], variants: list[str], window: int, batch: int) -
             o_batch = batch / (
                 latency_ms(lambda s=sn, b=big_np: s.run(None, {"x": b}), 20, 3)[0] / 1e3
             )
-            streams, _ = sustained_streams(path, rec.x[windows.start[0] :][: window + 12])
             row = {
                 "variant": name,
                 "flops_per_window": flops,
@@ -128,14 +85,85 @@ def bench_infer(data: list[str], variants: list[str], window: int, batch: int) -
                 "torch_batched_wps": t_batch,
                 "ort_batched_wps": o_batch,
                 "ort_flop_fraction": o_batch * flops / peak,
-                "streams_20hz": streams,
             }
             rows.append(row)
             print(
                 f"{name:<20} {flops / 1e6:6.2f} MFLOP/win | batch-1 torch {t_eager[0]:.3f}/"
                 f"{t_eager[1]:.3f} ms  ORT {o_eager[0]:.3f}/{o_eager[1]:.3f} ms (median/p95) | "
                 f"batched torch {t_batch:,.0f}/s  ORT {o_batch:,.0f}/s = "
-                f"{row['ort_flop_fraction']:.1%} of matmul | {streams} streams @20 Hz",
+                f"{row['ort_flop_fraction']:.1%} of matmul",
                 flush=True,
             )
     return rows
+
+
+def bench_deployed(model_path: str, data: list[str], batch: int) -> dict:
+    """One exported model: onnxruntime batch-1 latency on one thread (the windowed graph, and a
+    fleet step of one stream with the incremental form), and the batched windowed path's
+    throughput as a share of the matmul rate measured in the same run."""
+    import onnxruntime as ort
+    import torch
+    from torch.utils.flop_counter import FlopCounterMode
+
+    from robohealth_mj.data.arrays import load_recordings
+    from robohealth_mj.data.windows import make_windows
+    from robohealth_mj.learn.trainer import expand_paths
+    from robohealth_mj.runtime.export import read_metadata
+    from robohealth_mj.runtime.fleet import FleetRuntime
+
+    meta = read_metadata(model_path)
+    window = int(meta["window"])
+    rec = load_recordings(expand_paths(data))
+    windows = make_windows(rec, window)
+    pick = np.linspace(0, len(windows) - 1, max(batch, 256)).astype(int)
+    raw = rec.x[windows.start[pick][:, None] + np.arange(window)]
+    torch.manual_seed(0)
+    model = fresh_variant(meta["variant"], window).eval()  # same architecture: same FLOPs
+    with FlopCounterMode(display=False) as counter, torch.no_grad():
+        model(torch.from_numpy(raw[:1]))
+    flops = counter.get_total_flops()
+    peak = matmul_rate()
+    one = ort.SessionOptions()
+    one.intra_op_num_threads = 1
+    s1 = ort.InferenceSession(model_path, one, providers=["CPUExecutionProvider"])
+    sn = ort.InferenceSession(model_path, providers=ort.get_available_providers())
+    k = iter(range(10**9))
+    b1 = latency_ms(lambda: s1.run(None, {"x": raw[next(k) % len(raw)][None]}), 1000, 50)
+    big = raw[:batch]
+    batched = batch / (latency_ms(lambda: sn.run(None, {"x": big}), 20, 3)[0] / 1e3)
+    fleet = FleetRuntime(model_path, threads=1)
+    slot = fleet.register(["one"])
+    x = rec.x
+    for t in range(window):  # fill the window
+        fleet.step(slot, np.array([t]), np.array([0.05 * (t + 1)]), x[t : t + 1])
+    step = iter(range(window, 10**9))
+
+    def one_tick() -> None:
+        t = next(step)
+        fleet.step(slot, np.array([t]), np.array([0.05 * (t + 1)]), x[t % len(x)][None])
+
+    tick = latency_ms(one_tick, 1000, 50)
+    row = {
+        "model": model_path,
+        "model_id": meta["model_id"],
+        "window": window,
+        "flops_per_window": flops,
+        "matmul_gflops": peak / 1e9,
+        "ort_b1_ms": b1,
+        "fleet_step_1_stream_ms": tick,
+        "fleet_mode": fleet.mode,
+        "ort_batched_wps": batched,
+        "ort_flop_fraction": batched * flops / peak,
+    }
+    print(
+        f"{meta['model_id']} (W={window}, {flops / 1e6:.2f} MFLOP/window); matmul rate "
+        f"{peak / 1e9:.0f} GFLOP/s\n"
+        f"  onnxruntime batch-1, one thread: median {b1[0]:.3f} ms, p95 {b1[1]:.3f} ms "
+        f"(targets 0.3 / 0.6; 1000 calls after 50 warm-ups)\n"
+        f"  fleet step of one stream ({fleet.mode}): median {tick[0]:.3f} ms, "
+        f"p95 {tick[1]:.3f} ms\n"
+        f"  batched ({batch} windows, all threads): {batched:,.0f} windows/s = "
+        f"{row['ort_flop_fraction']:.1%} of the matmul rate",
+        flush=True,
+    )
+    return row

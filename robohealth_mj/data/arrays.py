@@ -16,6 +16,7 @@ import numpy as np
 
 from robohealth_mj.atomic import atomic_write_bytes
 from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.errors import InputError
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, SCHEMA_VERSION
 
 CACHE_SUFFIX = ".cache.npz"
@@ -51,6 +52,11 @@ class Recording:
 
 
 def _key(path: Path) -> str:
+    if path.is_dir():  # a bag: its storage files say whether it changed
+        st = max((f.stat() for f in path.iterdir() if f.is_file()), key=lambda s: s.st_mtime_ns)
+        return json.dumps(
+            {"size": st.st_size, "mtime_ns": st.st_mtime_ns, "schema": SCHEMA_VERSION}
+        )
     st = path.stat()
     return json.dumps({"size": st.st_size, "mtime_ns": st.st_mtime_ns, "schema": SCHEMA_VERSION})
 
@@ -68,7 +74,7 @@ def _parse(path: Path) -> dict[str, np.ndarray]:
         act.append(s.fault.active)
         payload.append(float(s.segment["payload_scale"]))
     if not xs:
-        raise ValueError(f"{path}: no samples")
+        raise InputError(f"{path}: no samples (an empty recording)")
     return {
         "x": np.stack(xs).astype(np.float32),
         "run": np.array(runs, np.int32),
@@ -108,7 +114,7 @@ def load_recordings(paths: list[Path | str]) -> Recording:
         names = [str(r) for r in part["run_ids"]]
         duplicate = set(names) & set(run_ids)
         if duplicate:
-            raise ValueError(f"recording_run_id {sorted(duplicate)} appears in more than one file")
+            raise InputError(f"recording_run_id {sorted(duplicate)} appears in more than one file")
         runs.append(part["run"] + len(run_ids))
         run_ids += names
     cat = {
@@ -128,14 +134,21 @@ def load_recordings(paths: list[Path | str]) -> Recording:
     )
 
 
+def is_bag(path: Path) -> bool:
+    from robohealth_mj.bags.reader import is_bag as bag
+
+    return bag(path)
+
+
 def resolve_recordings(paths: list[str] | str) -> list[Path]:
-    """Files or session directories (their ``graphs.jsonl``); a corpus dir's ``train_*`` too."""
+    """Files, session directories (their ``graphs.jsonl``) or rosbag2 directories; a corpus
+    dir's ``train_*`` too."""
     out = []
     for raw in [paths] if isinstance(paths, str) else paths:
         p = Path(raw)
         if p.is_dir() and (p / "graphs.jsonl").is_file():
             out.append(p / "graphs.jsonl")
-        elif p.is_file():
+        elif is_bag(p) or p.is_file():
             out.append(p)
         else:
             raise FileNotFoundError(f"no recording at {raw}")

@@ -6,7 +6,9 @@ atomically (temp file + rename).
 
 from __future__ import annotations
 
+import hashlib
 import io
+import json
 from pathlib import Path
 from typing import Any
 
@@ -17,6 +19,7 @@ from torch import nn
 from robohealth_mj import schema
 from robohealth_mj.atomic import atomic_write_bytes
 from robohealth_mj.data.graphs import GraphSpec
+from robohealth_mj.errors import InputError
 from robohealth_mj.models import build_model
 
 FORMAT = "robohealth_mj.checkpoint/1"
@@ -60,15 +63,63 @@ def save_checkpoint(
         "best_epoch": int(best_epoch),
         **(extra or {}),
     }
+    payload["sha256"] = checkpoint_digest(payload)
     buffer = io.BytesIO()
     torch.save(payload, buffer)
     atomic_write_bytes(path, buffer.getvalue())
 
 
+def checkpoint_digest(payload: dict[str, Any]) -> str:
+    """SHA-256 over the weights, the normalisation and every other field: torch's archive does
+    not check its own contents, so altered bytes inside a tensor would otherwise load."""
+    digest = hashlib.sha256()
+    for key in sorted(payload["state_dict"]):
+        digest.update(key.encode())
+        digest.update(payload["state_dict"][key].contiguous().numpy().tobytes())
+    for key in ("norm_mean", "norm_std"):
+        digest.update(payload[key].numpy().tobytes())
+    rest = {
+        k: v
+        for k, v in payload.items()
+        if k not in ("state_dict", "norm_mean", "norm_std", "sha256")
+    }
+    digest.update(json.dumps(rest, sort_keys=True, default=str).encode())
+    return digest.hexdigest()
+
+
+_REQUIRED = ("state_dict", "model_cfg", "variant", "schema", "graph", "window", "norm_mean",
+             "norm_std", "labels", "config", "data_fingerprint")  # fmt: skip
+
+
 def load_checkpoint(path: Path | str) -> dict[str, Any]:
-    ckpt = torch.load(str(path), map_location="cpu", weights_only=True)
+    """A checkpoint, or an :class:`InputError` naming the file and what is wrong with it (empty,
+    truncated or altered bytes, another format, a missing key, another schema or topology)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no checkpoint file")
+    if path.stat().st_size == 0:
+        raise InputError(f"{path}: empty file, not a checkpoint")
+    try:
+        ckpt = torch.load(str(path), map_location="cpu", weights_only=True)
+    except Exception as exc:  # torch raises many types for damaged archives
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise InputError(
+            f"{path}: unreadable checkpoint, truncated or altered? ({type(exc).__name__}: "
+            f"{first[:160]})"
+        ) from None
     if not isinstance(ckpt, dict) or ckpt.get("format") != FORMAT:
-        raise ValueError(f"{path}: not a robohealth_mj checkpoint ({FORMAT})")
+        raise InputError(f"{path}: not a robohealth_mj checkpoint ({FORMAT})")
+    missing = [k for k in _REQUIRED if k not in ckpt]
+    if missing:
+        raise InputError(f"{path}: key '{missing[0]}' missing from the checkpoint")
+    if "sha256" in ckpt and checkpoint_digest(ckpt) != ckpt["sha256"]:
+        raise InputError(
+            f"{path}: checksum mismatch: the checkpoint was altered after it was written"
+        )
+    try:
+        check_schema(ckpt, f"{path} (checkpoint)")
+    except (KeyError, TypeError) as exc:
+        raise InputError(f"{path}: key 'schema' malformed ({exc})") from None
     return ckpt
 
 
@@ -93,19 +144,25 @@ def model_from_checkpoint(ckpt: dict[str, Any]) -> nn.Module:
         len(ckpt["schema"]["feature_names"]),
         ckpt["window"],
     )
-    model.load_state_dict(ckpt["state_dict"])
+    try:
+        model.load_state_dict(ckpt["state_dict"])
+    except RuntimeError as exc:
+        first = str(exc).splitlines()[0]
+        raise InputError(f"checkpoint key 'state_dict' does not fit its model: {first}") from None
     return model.eval()
 
 
 def check_schema(ckpt: dict[str, Any], source: str) -> None:
     """Refuse data whose node order or topology differs from what the model was trained on."""
     s = ckpt["schema"]
+    if s["version"] != schema.SCHEMA_VERSION:
+        raise InputError(
+            f"{source}: schema {schema.SCHEMA_VERSION} here, the checkpoint's is {s['version']}"
+        )
     if s["node_names"] != list(schema.NODE_NAMES):
-        raise ValueError(
+        raise InputError(
             f"{source}: node order {list(schema.NODE_NAMES)} differs from the "
             f"checkpoint's {s['node_names']}"
         )
     if s["edges"] != [list(e) for e in schema.EDGES]:
-        raise ValueError(f"{source}: graph topology differs from the checkpoint's")
-    if s["version"] != schema.SCHEMA_VERSION:
-        raise ValueError(f"{source}: schema {schema.SCHEMA_VERSION} != checkpoint's {s['version']}")
+        raise InputError(f"{source}: graph topology differs from the checkpoint's")

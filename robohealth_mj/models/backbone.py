@@ -168,6 +168,11 @@ class WindowEncoder(nn.Module):
         if self.statistics:
             views.append(torch.asinh(window_statistics(x, self.first_signal)))
             views.append(x[:, -1, :, : self.first_signal])  # node-type flags
+        return self.embed(views)
+
+    def embed(self, views: list[torch.Tensor]) -> torch.Tensor:
+        """The pooled views ``[B, N, *]`` (in :meth:`forward`'s order) -> ``[B, N, H]``; shared
+        with the incremental form, which pools the views itself."""
         h = self.project(torch.cat(views, dim=-1))
         return h if self.node is None else h + self.node
 
@@ -218,7 +223,12 @@ class WindowBackbone(nn.Module):
     def forward(
         self, x: torch.Tensor, adj: torch.Tensor
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        skip = self.encoder(x)
+        return self.message_passing(self.encoder(x), adj)
+
+    def message_passing(
+        self, skip: torch.Tensor, adj: torch.Tensor
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Per-window node embeddings ``[B, N, H]`` -> ``(refined, temporal, skip)``."""
         h = skip
         for conv in self.convs:
             h = conv(h, adj)

@@ -45,23 +45,35 @@ def export_onnx(
 ) -> list[str]:
     """Write ``path`` with input ``x: float32[batch, W, N, F]``; returns the output names."""
     wrapper = ExportWrapper(model, pre).eval()
+    export_module(wrapper, (example,), path, ["x"], wrapper.output_names, opset)
+    return wrapper.output_names
+
+
+def export_module(
+    module: nn.Module,
+    examples: tuple[torch.Tensor, ...],
+    path: Path | str,
+    input_names: list[str],
+    output_names: list[str],
+    opset: int = 18,
+) -> None:
+    """Write ``path``: ``module`` on ``examples``, every input's first axis a dynamic batch."""
     batch = torch.export.Dim("batch", min=1, max=65536)
     for name in ("onnx_ir", "onnxscript", "torch.onnx"):  # their INFO lines are not ours to print
         logging.getLogger(name).setLevel(logging.WARNING)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         torch.onnx.export(
-            wrapper,
-            (example,),
+            module.eval(),
+            examples,
             str(path),
             dynamo=True,
             opset_version=opset,
-            input_names=["x"],
-            output_names=wrapper.output_names,
-            dynamic_shapes={"x": {0: batch}},
+            input_names=input_names,
+            output_names=output_names,
+            dynamic_shapes=tuple({0: batch} for _ in examples),
             verbose=False,
         )
-    return wrapper.output_names
 
 
 def onnx_parity(

@@ -95,6 +95,17 @@ class STGNN(nn.Module):
 
     def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:
         positions, (refined, temporal, skip) = self._features(x)
+        return self.heads(positions, refined, temporal, skip)
+
+    def heads(
+        self,
+        positions: torch.Tensor,
+        refined: torch.Tensor,
+        temporal: torch.Tensor,
+        skip: torch.Tensor,
+    ) -> dict[str, torch.Tensor]:
+        """The output heads on the backbone's node embeddings (shared with the incremental
+        form): positions ``[B, N]``, embeddings ``[B, N, H]`` -> the output dict."""
         out = {"class_logits": self.classifier(refined, positions[:, : self.num_joints])}
         if self.anomaly is not None:
             out["joint_logits"], out["recon_energy"] = self.anomaly(temporal)

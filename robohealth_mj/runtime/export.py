@@ -8,8 +8,10 @@ checks: node order, feature names, window, label table, schema version, fingerpr
 
 from __future__ import annotations
 
+import base64
 import hashlib
 import json
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +24,7 @@ from robohealth_mj import schema
 from robohealth_mj.atomic import atomic_write_bytes
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.windows import make_windows
+from robohealth_mj.errors import InputError
 from robohealth_mj.learn.checkpoint import (
     check_schema,
     graph_from_checkpoint,
@@ -29,7 +32,8 @@ from robohealth_mj.learn.checkpoint import (
     model_from_checkpoint,
 )
 from robohealth_mj.learn.trainer import expand_paths
-from robohealth_mj.models.onnx import export_onnx, onnx_parity
+from robohealth_mj.models.incremental import PooledHead, SnapshotStep, supports_incremental
+from robohealth_mj.models.onnx import ExportWrapper, export_module, export_onnx, onnx_parity
 
 PARITY_TOLERANCE = 1e-4
 
@@ -80,6 +84,91 @@ def heldout_windows(ckpt: dict[str, Any], data: str | list[str] | None, count: i
     return torch.from_numpy(rec.x[idx])
 
 
+def heldout_run(ckpt: dict[str, Any], data: str | list[str] | None, count: int) -> torch.Tensor:
+    """The first ``count`` consecutive raw snapshots ``[count, 12, F]`` of one held-out run."""
+    data = data or ckpt["config"].get("data", {}).get("evaluate", {}).get("heldout")
+    rec = load_recordings(expand_paths(data))
+    same = (rec.run == rec.run[0]) & (np.diff(rec.sample_index, prepend=-1) == 1)
+    length = int(np.argmin(same)) if not same.all() else len(rec)
+    if length < count:
+        raise ValueError(f"held-out data has no run of {count} consecutive samples")
+    return torch.from_numpy(rec.x[:count])
+
+
+def incremental_graphs(
+    model: nn.Module, pre: nn.Module, run: torch.Tensor, window: int
+) -> dict[str, str]:
+    """The incremental form's two graphs (base64 ONNX, for the metadata) after checking it
+    against the windowed model on every window of ``run`` (``[T, 12, F]`` consecutive)."""
+    import onnxruntime as ort
+
+    from robohealth_mj.runtime.incremental import IncrementalEngine
+
+    step, head = SnapshotStep(model, pre).eval(), PooledHead(model).eval()
+    with torch.no_grad():
+        z = pre(run[:2, None])[:, 0]
+        z, g, _ = step(run[:2], z, z, torch.ones(2))
+    n, f, channels = z.shape[1], z.shape[2], g.shape[2]
+    signals = f - model.backbone.encoder.first_signal
+    examples = (torch.zeros(2, n, 3 * channels + 7 * signals + f - signals), z)
+    blobs = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        export_module(
+            step,
+            (run[:2], z, z.clone() + 1.0, torch.ones(2)),  # distinct: aliased inputs merge
+            f"{tmp}/encode.onnx",
+            ["x_new", "z_prev", "z_first", "has_prev"],
+            ["z_new", "g_new", "g_first"],
+        )
+        export_module(
+            head,
+            examples,
+            f"{tmp}/head.onnx",
+            ["views", "z_last"],
+            head.output_names,
+        )
+        for name in ("encode", "head"):
+            proto = onnx.load(f"{tmp}/{name}.onnx")  # external weights folded in
+            blobs[name] = proto.SerializeToString()
+    engine = IncrementalEngine(
+        ort.InferenceSession(blobs["encode"], providers=["CPUExecutionProvider"]),
+        ort.InferenceSession(blobs["head"], providers=["CPUExecutionProvider"]),
+        window,
+        n,
+        f,
+        channels,
+        model.backbone.encoder.first_signal,
+        capacity=1,
+    )
+    slot = np.zeros(1, dtype=np.int64)
+    got, starts = [], []
+    for t in range(len(run)):
+        engine.push(slot, run[t : t + 1].numpy())
+        if engine.full(slot)[0]:
+            got.append(engine.infer(slot))
+            starts.append(t - window + 1)
+    idx = torch.as_tensor(starts)[:, None] + torch.arange(window)
+    with torch.no_grad():
+        reference = [o.numpy() for o in ExportWrapper(model, pre).eval()(run[idx])]
+    error = max(
+        float((np.abs(r - np.concatenate([o[k] for o in got])) / (1.0 + np.abs(r))).max())
+        for k, r in enumerate(reference)
+    )
+    if not error <= PARITY_TOLERANCE:
+        raise RuntimeError(
+            f"incremental form differs from the windowed model: {error:.3g} > {PARITY_TOLERANCE} "
+            f"on {len(starts)} consecutive windows"
+        )
+    return {
+        "incremental_encode": base64.b64encode(blobs["encode"]).decode("ascii"),
+        "incremental_head": base64.b64encode(blobs["head"]).decode("ascii"),
+        "incremental_parity_error": f"{error:.3g}",
+        "incremental_channels": str(channels),
+        "incremental_nodes": str(n),
+        "first_signal": str(model.backbone.encoder.first_signal),
+    }
+
+
 def export_checkpoint(
     ckpt_path: Path | str,
     out: Path | str,
@@ -110,6 +199,13 @@ def export_checkpoint(
             f"ONNX parity check failed: max |torch - onnxruntime| / (1 + |torch|) = {error:.3g} "
             f"> {PARITY_TOLERANCE} on {len(windows)} held-out windows"
         )
+    incremental = (
+        incremental_graphs(
+            model, pre, heldout_run(ckpt, data, 2 * int(ckpt["window"]) + 64), int(ckpt["window"])
+        )
+        if supports_incremental(model)
+        else {}
+    )
     fingerprint = file_fingerprint(ckpt_path)
     metadata = model_metadata(
         model_id=f"{ckpt['variant']}-{graph.name}-w{ckpt['window']}-{fingerprint[:8]}",
@@ -123,6 +219,7 @@ def export_checkpoint(
         data_fingerprint=ckpt["data_fingerprint"],
         code_version=ckpt["code_version"],
         parity_error=f"{error:.3g}",
+        **incremental,
     )
     attach_metadata(tmp, out, metadata)  # writes one self-contained file
     side_data.unlink(missing_ok=True)
@@ -172,9 +269,29 @@ def attach_metadata(src: Path | str, out: Path | str, metadata: dict[str, str]) 
 
 
 def read_metadata(path: Path | str) -> dict[str, Any]:
-    """The metadata an exported model carries, with JSON fields decoded."""
-    proto = onnx.load(str(path), load_external_data=False)
+    """The metadata an exported model carries, with JSON fields decoded; an :class:`InputError`
+    naming the file for anything that is not one of our exported models."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no model file")
+    try:
+        proto = onnx.load(str(path), load_external_data=False)
+    except Exception as exc:  # protobuf's DecodeError and friends
+        raise InputError(f"{path}: not an ONNX model ({type(exc).__name__})") from None
     raw = {p.key: p.value for p in proto.metadata_props}
+    missing = [k for k in ("model_id", "schema_version", "node_names", "window") if k not in raw]
+    if missing or not proto.graph.input:
+        raise InputError(
+            f"{path}: an ONNX model, but not one exported here (metadata key "
+            f"'{(missing or ['x'])[0]}' missing)"
+        )
+    dims = [d.dim_value or d.dim_param for d in proto.graph.input[0].type.tensor_type.shape.dim]
+    expected = [int(raw["window"]), schema.N_NODES, schema.N_FEATURES]
+    if proto.graph.input[0].name != "x" or dims[1:] != expected:
+        raise InputError(
+            f"{path}: input '{proto.graph.input[0].name}' has shape {dims}, expected "
+            f"[batch, {', '.join(map(str, expected))}] (x)"
+        )
     decoded: dict[str, Any] = dict(raw)
     for key in ("node_names", "feature_names", "edges", "classes", "joints", "outputs"):
         if key in raw:

@@ -1,0 +1,65 @@
+"""``python -m robohealth_mj.tune_alarms --model M --data SESSION``: choose alarm settings on a
+selection recording (record one with a seed of its own; never tune on the held-out session).
+
+The model's decisions are computed once (``--healthy``: also on a healthy-only session, so that
+false alarms per hour rest on hours, not minutes), then every policy of the grid replays over
+them; the
+table (markdown) lists each policy's detection rate, false alarms and latency, and the last line
+names the policy that meets the targets with the lowest median latency to class. Put it in
+``conf/monitor.yaml``'s ``alarm`` block.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from robohealth_mj.runtime.alarm_sweep import choose, meets_targets, replay_decisions, sweep
+
+
+def _f(value: float | None) -> str:
+    return "–" if value is None else f"{value:.3g}"
+
+
+def main(argv: list[str] | None = None) -> dict:
+    parser = argparse.ArgumentParser(
+        prog="python -m robohealth_mj.tune_alarms", description=__doc__
+    )
+    parser.add_argument("--model", required=True, help="an exported model.onnx")
+    parser.add_argument("--data", required=True, help="a selection session's graphs.jsonl")
+    parser.add_argument("--healthy", help="a healthy-only selection session, for false alarms/h")
+    args = parser.parse_args(argv)
+    try:
+        decisions = replay_decisions(args.model, args.data)
+        healthy = replay_decisions(args.model, args.healthy) if args.healthy else None
+    except (OSError, ValueError) as exc:  # SchemaError, InputError and BagError among them
+        print(f"tune_alarms: error: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
+    rows = sweep(decisions, healthy=healthy)
+    print(
+        f"selection: {args.data} (faults)"
+        + (f" + {args.healthy} (healthy)" if args.healthy else "")
+        + f"; {rows[0]['healthy_hours']:.2f} h of settled healthy running\n"
+    )
+    print(
+        "| raise_after | clear_after | min_confidence | detected | false alarm ticks | "
+        "false alarms / h | to class s | to joint s | meets targets |\n"
+        "|---|---|---|---|---|---|---|---|---|"
+    )
+    for r in rows:
+        print(
+            f"| {r['raise_after']} | {r['clear_after']} | {r['min_confidence']} | "
+            f"{_f(r['detection_rate'])} | {_f(r['false_alarm_rate'])} | "
+            f"{_f(r['false_alarms_per_hour'])} | {_f(r['class_latency_s_median'])} | "
+            f"{_f(r['joint_latency_s_median'])} | {'yes' if meets_targets(r) else ''} |"
+        )
+    best = choose(rows)
+    print(
+        f"\nchosen: raise_after={best['raise_after']} clear_after={best['clear_after']} "
+        f"min_confidence={best['min_confidence']} (selection data: {args.data})"
+    )
+    return best
+
+
+if __name__ == "__main__":
+    main()

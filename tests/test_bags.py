@@ -1,0 +1,246 @@
+"""ROS 2 bags: round trip, ROS 2 message definitions, clear errors for bad bags, the monitor's
+diagnoses out, and one-line errors (exit status 2) for every kind of bad file."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from robohealth_mj.bag import main as bag_main
+from robohealth_mj.bags.messages import MessageFactory, stamp_ns, typestore
+from robohealth_mj.bags.reader import BagError, read_bag_samples
+from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.data.arrays import load_recordings
+from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.dataset import main as dataset_main
+from robohealth_mj.learn.checkpoint import checkpoint_digest
+from robohealth_mj.monitor import main as monitor_main
+
+
+@pytest.fixture(scope="module")
+def bag(deployed, tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("bags") / "heldout_bag"
+    assert bag_main(["write", str(deployed["heldout"].parent), "--out", str(out)]) == 0
+    return out
+
+
+def test_jsonl_to_bag_to_samples_is_the_identity(deployed, bag):
+    a, b = list(read_samples(deployed["heldout"])), list(read_samples(bag))
+    assert len(a) == len(b) > 100
+    for x, y in zip(a, b, strict=True):
+        np.testing.assert_allclose(y.x, x.x, rtol=0, atol=1e-6)
+        assert (x.recording_run_id, x.sample_index, x.fault, x.segment) == (
+            y.recording_run_id, y.sample_index, y.fault, y.segment,
+        )  # fmt: skip
+        assert y.t == pytest.approx(x.t, abs=1e-9)
+    ra, rb = load_recordings([deployed["heldout"]]), load_recordings([bag])
+    np.testing.assert_array_equal(ra.x, rb.x)
+    np.testing.assert_array_equal(ra.fault_class, rb.fault_class)
+
+
+def test_the_bag_is_standard_rosbag2_with_ros2_message_definitions(deployed, bag):
+    import yaml
+    from rosbags.rosbag2 import Reader
+
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    assert info["storage_identifier"] == "mcap" and info["version"] >= 8
+    manifest = json.loads(info["custom_data"]["robohealth_mj.manifest"])
+    assert manifest["recording_run_id"] == next(read_samples(deployed["heldout"])).recording_run_id
+    store = typestore()  # ROS 2 Humble's definitions
+    expected = BagTopics.load().sample_topics()
+    with Reader(bag) as reader:
+        assert {c.topic: c.msgtype for c in reader.connections} == expected
+        for conn in reader.connections:  # definitions embedded for readers without ROS
+            assert conn.msgdef.data.strip() and conn.msgtype.split("/")[0] in (
+                "sensor_msgs", "std_msgs", "diagnostic_msgs",
+            )  # fmt: skip
+        count = 0
+        for conn, stamp, raw in reader.messages():
+            msg = store.deserialize_cdr(raw, conn.msgtype)
+            assert bytes(store.serialize_cdr(msg, conn.msgtype)) == bytes(raw)  # exact CDR
+            header = getattr(msg, "header", None)
+            if header is not None:
+                assert header.stamp.sec * 10**9 + header.stamp.nanosec == stamp
+            count += 1
+    assert count == len(expected) * len(list(read_samples(bag)))
+
+
+def _write_edited(samples, out: Path, edit) -> None:
+    """A bag of ``samples`` where ``edit(topic, k, raw)`` returns the bytes to write (None to
+    drop the message) and may move its stamp by returning ``(raw, stamp)``."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    store = typestore()
+    factory = MessageFactory(store)
+    topics = BagTopics.load()
+    with Writer(out, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
+        conns = {}
+        for k, s in enumerate(samples):
+            for topic, msg in factory.sample_messages(s, topics):
+                raw = store.serialize_cdr(msg, msg.__msgtype__)
+                got = edit(topic, k, raw)
+                if got is None:
+                    continue
+                raw, stamp = got if isinstance(got, tuple) else (got, stamp_ns(s.t))
+                if topic not in conns:
+                    conns[topic] = writer.add_connection(topic, msg.__msgtype__, typestore=store)
+                writer.write(conns[topic], stamp, raw)
+
+
+ELBOW_VIB = "/sensors/elbow/vibration"
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda topic, k, raw: None if topic == "/sensors/elbow/imu" else raw,
+         "topic '/sensors/elbow/imu' (sensor_msgs/msg/Imu) is missing"),
+        (lambda topic, k, raw: None if (topic, k) == ("/sensors/wrist_1/vibration", 7) else raw,
+         "topic '/sensors/wrist_1/vibration' at stamp 0.400000 s: message missing"),
+        (lambda topic, k, raw: raw[:12] if (topic, k) == ("/joint_states", 5) else raw,
+         "topic '/joint_states' at stamp 0.300000 s: malformed message"),
+        (lambda topic, k, raw: (raw, stamp_ns(0.325)) if (topic, k) == (ELBOW_VIB, 5) else raw,
+         "no '/joint_states' message at that stamp (late, early or stray)"),
+    ],
+    ids=["missing topic", "gap", "malformed", "late"],
+)  # fmt: skip
+def test_a_bad_bag_names_its_topic_and_stamp(deployed, tmp_path, edit, message):
+    samples = list(read_samples(deployed["heldout"]))[:20]
+    out = tmp_path / "bad"
+    _write_edited(samples, out, edit)
+    with pytest.raises(BagError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        list(read_bag_samples(out))
+    assert dataset_main(["summarize", str(out)]) == 2
+
+
+def test_monitor_replays_a_bag_and_writes_its_diagnoses_beside_the_topics(deployed, bag, tmp_path):
+    from rosbags.rosbag2 import Reader
+
+    def diagnoses(path: Path) -> list[tuple]:
+        store = typestore()
+        with Reader(path) as reader:
+            conns = [c for c in reader.connections if c.topic == "/health_diagnosis"]
+            out = []
+            for _, stamp, raw in reader.messages(connections=conns):
+                status = store.deserialize_cdr(raw, conns[0].msgtype).status[0]
+                values = {kv.key: kv.value for kv in status.values}
+                out.append((stamp, status.level, status.message, values["fault_class"],
+                            values["joint"], values["alarm"], values["confidence"]))  # fmt: skip
+            return out
+
+    model = deployed["structural_onnx"]
+    for source, out in ((deployed["heldout"], tmp_path / "a"), (bag, tmp_path / "b")):
+        monitor_main([f"model={model}", "source=replay", f"file={source}", "quiet=true",
+                      f"bag_out={out}"])  # fmt: skip
+    from_jsonl, from_bag = diagnoses(tmp_path / "a"), diagnoses(tmp_path / "b")
+    assert len(from_bag) == len(list(read_samples(bag))) and from_jsonl == from_bag
+    assert {d[1] for d in from_bag} >= {0}  # OK levels at least; the tiny model may not alarm
+    with Reader(tmp_path / "b") as reader:
+        assert {c.topic for c in reader.connections} >= set(BagTopics.load().sample_topics())
+
+
+def test_training_on_bags_equals_training_on_their_jsonl(deployed, bag, tmp_path):
+    from robohealth_mj.config import compose_config
+    from robohealth_mj.train import run
+
+    names = ("train_a", "train_b", "train_c")
+    bags = [tmp_path / f"{name}_bag" for name in names]
+    for name, out in zip(names, bags, strict=True):
+        assert bag_main(["write", str(deployed["root"] / name), "--out", str(out)]) == 0
+    jsonl = [deployed["root"] / name for name in names]
+    results = []
+    for train, heldout in ((bags, bag), (jsonl, deployed["heldout"])):
+        cfg = compose_config(
+            "train",
+            [f"data.train=[{','.join(map(str, train))}]", f"data.evaluate.heldout={heldout}",
+             "data.evaluate.probe=null", "trainer.epochs=1", "trainer.progress=false",
+             "model.hidden=8", "window=8", "variant=mlp"],
+        )  # fmt: skip
+        results.append(run(cfg, tmp_path / f"run{len(results)}")["heldout"]["metrics"])
+    assert results[0]["accuracy"] == results[1]["accuracy"]
+    assert results[0]["localisation_accuracy"] == results[1]["localisation_accuracy"]
+
+
+def _python(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", *args], capture_output=True, text=True, timeout=300
+    )
+
+
+def _one_line_error(proc: subprocess.CompletedProcess, *needles: str) -> None:
+    lines = [line for line in proc.stderr.splitlines() if line.strip() and "Warning" not in line]
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr, proc.stderr
+    assert len(lines) == 1, proc.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def bad_files(deployed, tmp_path_factory) -> dict[str, Path]:
+    import onnx
+    import torch
+
+    root = tmp_path_factory.mktemp("bad")
+    good = deployed["structural_ckpt"].read_bytes()
+    files = {
+        "empty_ckpt": root / "empty.ckpt",
+        "truncated_ckpt": root / "truncated.ckpt",
+        "tampered_ckpt": root / "tampered.ckpt",
+        "schema_ckpt": root / "schema.ckpt",
+        "topology_ckpt": root / "topology.ckpt",
+        "not_onnx": root / "not.onnx",
+        "shape_onnx": root / "shape.onnx",
+        "empty_recording": root / "empty" / "graphs.jsonl",
+        "no_recording": root / "nothing",
+    }
+    files["empty_ckpt"].write_bytes(b"")
+    files["truncated_ckpt"].write_bytes(good[: len(good) // 2])
+    tampered = bytearray(good)
+    middle = len(tampered) // 2
+    tampered[middle : middle + 64] = b"\x00" * 64
+    files["tampered_ckpt"].write_bytes(bytes(tampered))
+    ckpt = torch.load(deployed["structural_ckpt"], weights_only=True)
+    ckpt["schema"] = {**ckpt["schema"], "version": "1.0"}
+    ckpt["sha256"] = checkpoint_digest(ckpt)  # a sound file, written for another schema
+    torch.save(ckpt, files["schema_ckpt"])
+    ckpt = torch.load(deployed["structural_ckpt"], weights_only=True)
+    ckpt["schema"] = {**ckpt["schema"], "edges": ckpt["schema"]["edges"][:-1]}
+    ckpt["sha256"] = checkpoint_digest(ckpt)
+    torch.save(ckpt, files["topology_ckpt"])
+    files["not_onnx"].write_bytes(b"this is not a model")
+    proto = onnx.load(str(deployed["structural_onnx"]))
+    proto.graph.input[0].type.tensor_type.shape.dim[2].dim_value = 10
+    onnx.save(proto, str(files["shape_onnx"]))
+    files["empty_recording"].parent.mkdir()
+    files["empty_recording"].write_text("")
+    files["no_recording"].mkdir()
+    return files
+
+
+@pytest.mark.parametrize(
+    "key, command, needles",
+    [
+        ("empty_ckpt", "evaluate ckpt={f} data={heldout}", ["empty.ckpt", "empty file"]),
+        ("truncated_ckpt", "evaluate ckpt={f} data={heldout}", ["truncated.ckpt", "unreadable"]),
+        ("tampered_ckpt", "export ckpt={f}", ["tampered.ckpt", "altered"]),
+        ("schema_ckpt", "evaluate ckpt={f} data={heldout}", ["schema.ckpt", "schema 2.0", "1.0"]),
+        ("topology_ckpt", "export ckpt={f}", ["topology.ckpt", "topology"]),
+        ("not_onnx", "monitor model={f} source=replay file={heldout}", ["not.onnx", "not an ONNX"]),
+        ("shape_onnx", "monitor model={f} source=replay file={heldout}", ["shape.onnx", "'x'"]),
+        ("empty_recording", "evaluate ckpt={ckpt} data={f}", ["graphs.jsonl", "no samples"]),
+        ("no_recording", "evaluate ckpt={ckpt} data={f}", ["nothing", "no recording"]),
+        ("no_recording", "dataset summarize {f}", ["nothing", "no recording"]),
+        ("empty_recording", "bag write {f}", ["graphs.jsonl", "no samples"]),
+    ],
+)  # fmt: skip
+def test_every_bad_file_gets_one_line_and_exit_status_2(deployed, bad_files, key, command, needles):
+    args = command.format(
+        f=bad_files[key], heldout=deployed["heldout"], ckpt=deployed["structural_ckpt"]
+    ).split()
+    _one_line_error(_python(f"robohealth_mj.{args[0]}", *args[1:]), *needles)

@@ -1,0 +1,253 @@
+"""The fleet runtime: ring-buffer windows, incremental = windowed inference, bulk validation and
+bursts, alarms (debouncing, hysteresis), alarm-based on-line metrics and a short soak."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robohealth_mj import schema
+from robohealth_mj.benchmarks.common import fresh_variant
+from robohealth_mj.benchmarks.soak import KINDS, soak
+from robohealth_mj.data.arrays import load_recordings
+from robohealth_mj.models.incremental import supports_incremental
+from robohealth_mj.monitor import main as monitor_main
+from robohealth_mj.runtime.alarms import CLEARED, HELD, NONE, RAISED, AlarmBank, AlarmPolicy
+from robohealth_mj.runtime.fleet import BUFFERED, DECIDED, INVALID, WARMING, FleetRuntime
+from robohealth_mj.runtime.online_eval import OnlineEvaluator
+from robohealth_mj.runtime.runtime import HealthDiagnosis
+from robohealth_mj.schema import FaultLabel
+
+# Incremental and windowed inference agree to this (max |p_incremental - p_windowed|): float32
+# two-pass window statistics against float64 running sums, and two float32 graphs against one.
+TOLERANCE = 1e-4
+
+
+def _replay(fleet: FleetRuntime, x: np.ndarray, streams: int, ticks: int, skip: dict | None = None):
+    """Stream ``k`` replays ``x`` from offset ``37 k``; ``skip`` {tick: stream} drops a sample
+    (a gap). Returns probs [ticks, streams, C] (NaN where undecided) and the windows' starts."""
+    slots = fleet.register([f"s{k}" for k in range(streams)])
+    offsets = 37 * np.arange(streams)
+    probs = np.full((ticks, streams, len(fleet.classes)), np.nan, np.float32)
+    for t in range(ticks):
+        send = np.array([skip is None or skip.get(t) != k for k in range(streams)])
+        r = fleet.step(slots[send], np.full(send.sum(), t), np.full(send.sum(), 0.05 * (t + 1)),
+                       x[offsets[send] + t])  # fmt: skip
+        decided = r.status == DECIDED
+        probs[t, np.flatnonzero(send)[decided]] = r.probs[decided]
+    return probs
+
+
+def test_ring_buffer_windows_equal_the_batch_windows(deployed):
+    rec = load_recordings([deployed["heldout"]])
+    fleet = FleetRuntime(deployed["structural_onnx"], incremental=False)
+    assert fleet.mode == "windowed"
+    slots = fleet.register(["a", "b", "c"])
+    offsets = np.array([0, 50, 120])
+    for t in range(30):
+        fleet.step(slots, np.full(3, t), np.full(3, 0.05 * (t + 1)), rec.x[offsets + t])
+        if t + 1 >= fleet.window:
+            got = fleet.engine.windows(slots)
+            for k, off in enumerate(offsets):
+                end = off + t
+                assert rec.run[end - fleet.window + 1] == rec.run[end]  # one recording run
+                expected = rec.x[end - fleet.window + 1 : end + 1]
+                np.testing.assert_array_equal(got[k], expected)
+
+
+def test_incremental_inference_equals_windowed_inference(deployed):
+    rec = load_recordings([deployed["heldout"]])
+    for graph in ("structural", "harness"):
+        incremental = FleetRuntime(deployed[f"{graph}_onnx"])
+        windowed = FleetRuntime(deployed[f"{graph}_onnx"], incremental=False)
+        assert (incremental.mode, windowed.mode) == ("incremental", "windowed")
+        skip = {20: 1, 45: 2}  # gaps restart those streams' windows
+        a = _replay(incremental, rec.x, 4, 80, skip)
+        b = _replay(windowed, rec.x, 4, 80, skip)
+        assert np.array_equal(np.isnan(a), np.isnan(b))
+        assert (~np.isnan(a)).sum() > 200
+        assert np.nanmax(np.abs(a - b)) <= TOLERANCE
+
+
+def test_models_without_an_incremental_form_fall_back_to_windows():
+    assert supports_incremental(fresh_variant("anomaly_residual", 8))
+    assert not supports_incremental(fresh_variant("anomaly_residual", 8, "backbone=thesis"))
+    assert not supports_incremental(
+        fresh_variant("anomaly_residual", 8, "model.backbone.convolutions=true")
+    )
+
+
+def test_each_bad_row_is_flagged_with_its_reason_and_the_rest_decided(deployed):
+    rec = load_recordings([deployed["heldout"]])
+    fleet = FleetRuntime(deployed["structural_onnx"], max_streams=8)
+    slots = fleet.register([f"s{k}" for k in range(6)])
+    for t in range(fleet.window):
+        fleet.step(slots, np.full(6, t), np.full(6, 0.05 * (t + 1)), rec.x[t : t + 6])
+    t = fleet.window
+    x = rec.x[t : t + 6].copy()
+    index, stamp = np.full(6, t), np.full(6, 0.05 * (t + 1))
+    x[0, 8, 5] = np.inf
+    x[1] = x[1][::-1]
+    x[2, 0, 10] = 1.0  # a sensor channel on a joint node
+    stamp[3] = 0.0
+    index[4] += 3
+    layout_ok = np.array([True, True, True, True, True, True])
+    r = fleet.step(slots, index, stamp, x, layout_ok)
+    assert list(r.status) == [INVALID] * 5 + [DECIDED]
+    where = f"x[{schema.NODE_NAMES[8]}].{schema.FEATURE_NAMES[5]}"
+    assert where in r.reasons[0] and "NaN or Inf" in r.reasons[0]
+    assert "node-type indicators" in r.reasons[1]
+    assert "joint nodes must zero the sensor channels" in r.reasons[2]
+    assert "time went backwards" in r.reasons[3]
+    assert "gap in sample_index" in r.reasons[4] and "window restarted" in r.reasons[4]
+    r = fleet.step(slots[:1], [t + 1], [0.05 * (t + 2)], x[5:6], np.array([False]))
+    assert "node order differs" in r.reasons[0]
+    r = fleet.step(np.array([99]), [0], [0.05], x[5:6])
+    assert r.status[0] == INVALID and "unknown stream" in r.reasons[0]
+    r = fleet.step(slots[:1], [0], [0.05], np.zeros((1, 3, 3), np.float32))
+    assert "shape" in r.reasons[0]
+    # the stream limit: 8 slots
+    assert (fleet.register([f"n{k}" for k in range(3)]) == [6, 7, -1]).all()
+
+
+def test_a_burst_is_taken_in_order_up_to_the_limit(deployed):
+    rec = load_recordings([deployed["heldout"]])
+    one = FleetRuntime(deployed["structural_onnx"], max_burst=5)
+    each = FleetRuntime(deployed["structural_onnx"])
+    s1, s2 = one.register(["a"]), each.register(["a"])
+    n = one.window + 7
+    burst = one.step(np.repeat(s1, n), np.arange(n), 0.05 * (np.arange(n) + 1), rec.x[:n])
+    assert list(burst.status[:5]) == [WARMING] * 5
+    assert all("burst" in burst.reasons[k] for k in range(5, n))
+    singles = [each.step(s2, [k], [0.05 * (k + 1)], rec.x[k : k + 1]) for k in range(5)]
+    assert [s.status[0] for s in singles] == list(burst.status[:5])
+    # the next sample after the dropped ones is a gap
+    r = one.step(s1, [n], [0.05 * (n + 1)], rec.x[n : n + 1])
+    assert "gap" in r.reasons[0]
+    # a warmed-up stream's burst is buffered in order and decided once, on its last sample
+    w = each.window
+    for k in range(5, w + 5):
+        each.step(s2, [k], [0.05 * (k + 1)], rec.x[k : k + 1])
+    other = FleetRuntime(deployed["structural_onnx"])
+    s3 = other.register(["a"])
+    for k in range(w + 5):
+        other.step(s3, [k], [0.05 * (k + 1)], rec.x[k : k + 1])
+    k = np.arange(w + 5, w + 9)
+    burst = each.step(np.repeat(s2, 4), k, 0.05 * (k + 1), rec.x[k])
+    assert list(burst.status) == [BUFFERED] * 3 + [DECIDED]
+    for j in k:  # the same samples one tick each
+        single = other.step(s3, [j], [0.05 * (j + 1)], rec.x[j : j + 1])
+    np.testing.assert_allclose(burst.probs[-1], single.probs[0], atol=1e-6)
+
+
+def _probs(cls: int, p: float) -> np.ndarray:
+    out = np.full((1, 7), (1 - p) / 6, np.float32)
+    out[0, cls] = p
+    return out
+
+
+def _run(bank: AlarmBank, script: list[tuple[int, float, int]]) -> list[tuple[int, int, int]]:
+    slot = np.zeros(1, np.int64)
+    out = []
+    for cls, p, joint in script:
+        scores = np.full((1, 6), 0.1, np.float32)
+        scores[0, joint] = 0.9
+        state, alarm, j = bank.update(slot, _probs(cls, p), scores)
+        out.append((int(state[0]), int(alarm[0]), int(j[0])))
+    return out
+
+
+def test_alarms_raise_hold_and_clear_with_hysteresis():
+    policy = AlarmPolicy(raise_after=3, clear_after=4, min_confidence=0.8, clear_confidence=0.6)
+    bank = AlarmBank(policy, 6, 1)
+    jam = (3, 0.95, 2)
+    healthy = (0, 0.9, 0)
+    script = [healthy] * 2 + [jam] * 5 + [healthy] * 3 + [jam] + [healthy] * 4
+    states = _run(bank, script)
+    assert [s for s, _, _ in states] == (
+        [NONE] * 2 + [NONE, NONE, RAISED, HELD, HELD] + [HELD] * 3 + [HELD] + [HELD] * 3
+        + [CLEARED]
+    )  # fmt: skip
+    assert states[4][1:] == (3, 2)  # jam at elbow
+    assert states[-1][1:] == (0, -1)
+
+
+def test_alarms_suppress_flicker_and_low_confidence():
+    bank = AlarmBank(AlarmPolicy(raise_after=3, clear_after=3, min_confidence=0.8), 6, 1)
+    flicker = [(3, 0.95, 2), (0, 0.9, 0)] * 10
+    low = [(3, 0.6, 2)] * 10  # confident enough to win, not to vote
+    assert all(s == NONE for s, _, _ in _run(bank, flicker + low))
+
+
+def test_alarm_joint_follows_the_smoothed_scores_and_class_switches_reraise():
+    policy = AlarmPolicy(raise_after=2, clear_after=5, min_confidence=0.9, joint_smoothing=0.3)
+    bank = AlarmBank(policy, 6, 1)
+    states = _run(bank, [(1, 0.95, 4)] * 4 + [(1, 0.95, 1)] + [(2, 0.95, 1)] * 2)
+    assert states[1] == (RAISED, 1, 4)
+    assert states[4] == (HELD, 1, 4)  # one tick elsewhere does not move the joint
+    assert states[6] == (RAISED, 2, 1)  # two agreeing ticks of another class re-raise
+
+
+def test_alarm_policy_rejects_nonsense():
+    with pytest.raises(ValueError, match="raise_after"):
+        AlarmPolicy(raise_after=0)
+    with pytest.raises(ValueError, match="min_confidence"):
+        AlarmPolicy(min_confidence=1.5)
+
+
+def _diag(alarm: str = "none", cls: str | None = None, joint: str | None = None):
+    return HealthDiagnosis(
+        stamp=0.0, stream_id="s", sample_index=0, valid=True, fault_class="none",
+        alarm=alarm, alarm_class=cls, alarm_joint=joint,
+    )  # fmt: skip
+
+
+def test_online_alarm_metrics_on_a_scripted_stream_with_known_onsets():
+    healthy = FaultLabel()
+    jam = FaultLabel("jam", "elbow", 0.6, True)
+    drift = FaultLabel("sensor_drift", "wrist_1", 0.3, True)
+    up = _diag("held", "jam", "elbow")
+    script = (
+        [(healthy, _diag())] * 10
+        + [(healthy, _diag("raised", "jam", "wrist_1"))]  # a false alarm, settled healthy
+        + [(healthy, _diag("held", "jam", "wrist_1"))] * 2
+        + [(healthy, _diag("cleared"))]
+        + [(jam, _diag())] * 4  # onset at tick 14: 4 ticks without
+        + [(jam, _diag("raised", "jam", "wrist_1"))] * 2  # right class at +4
+        + [(jam, up)] * 4  # right joint at +6
+        + [(healthy, up)] * 3  # settling: not counted as false
+        + [(healthy, _diag())] * 7
+        + [(drift, _diag())] * 10  # never detected
+    )
+    ev = OnlineEvaluator(tick_s=0.05, settle_ticks=5)
+    for truth, d in script:
+        ev.update(truth, d)
+    r = ev.result()
+    assert r["episodes"] == 2
+    a = r["alarms"]
+    assert a["detected"] == 1 and a["detection_rate"] == 0.5
+    jam_a = r["alarms_by_class"]["jam"]
+    assert jam_a["class_latency_s_median"] == pytest.approx(0.20)
+    assert jam_a["joint_latency_s_median"] == pytest.approx(0.30)
+    assert r["alarms_by_class"]["sensor_drift"]["detected"] == 0
+    assert r["alarms_by_severity"]["0.3"]["detection_rate"] == 0.0
+    # settled healthy ticks: 14 before the jam, then 10 - 5 after it
+    assert r["settled_healthy_ticks"] == 14 + 5
+    assert r["false_alarm_rate"] == pytest.approx(3 / 19)
+    assert r["false_alarms"] == 1
+    assert r["false_alarms_per_hour"] == pytest.approx(1 / (19 * 0.05 / 3600))
+
+
+def test_a_short_soak_flags_every_bad_row_and_keeps_the_healthy_streams(deployed):
+    rec = load_recordings([deployed["heldout"]])
+    fleet = FleetRuntime(deployed["structural_onnx"], capacity=24, max_streams=24, shards=2)
+    report = soak(fleet, rec.x, 24, 330, bad_share=0.25).summary()
+    assert all(report["injected"][k] > 0 for k in KINDS), report["injected"]
+    assert sum(report["missed"].values()) == 0, report["missed"]
+    assert report["healthy_undecided"] == 0
+    assert fleet.capacity == 24  # state arrays allocated once
+
+
+def test_monitor_refuses_nonsense_alarm_settings(deployed):
+    with pytest.raises(SystemExit, match="min_confidence"):
+        monitor_main([f"model={deployed['structural_onnx']}", "alarm.min_confidence=2"])
