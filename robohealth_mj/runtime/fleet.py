@@ -250,11 +250,11 @@ class FleetRuntime:
         out = _empty(n, len(self.classes), len(self.joints))
         reasons: dict[int, str] = {}
         self.ticks += 1
+        x = np.asarray(x, np.float32)
         if x.shape[1:] != (schema.N_NODES, schema.N_FEATURES):
             for k in range(n):
                 reasons[k] = f"x has shape {x.shape[1:]}, not {(schema.N_NODES, schema.N_FEATURES)}"
             return TickResult(slots, sample_index, t, reasons=reasons, **out)
-        x = np.asarray(x, np.float32)
         known = (slots >= 0) & (slots < self.capacity)
         known[known] &= self.active[slots[known]]
         rank, size = _burst_rank(np.where(known, slots, -1 - np.arange(n)))

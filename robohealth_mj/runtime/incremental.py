@@ -255,4 +255,4 @@ class WindowedEngine(_Engine):
         return self.session.run(None, {"x": self.windows(slots)})
 
 
-assert NUM_STATISTICS == 7, "IncrementalEngine.infer stacks the seven window statistics"
+assert NUM_STATISTICS == 7, "IncrementalEngine.infer fills in the seven window statistics"
