@@ -19,7 +19,7 @@ import sys
 from collections import Counter
 from pathlib import Path
 
-from robohealth_mj.schema import SchemaError
+from robohealth_mj.errors import InputError, exit_status
 
 
 def _write(args: argparse.Namespace) -> int:
@@ -34,7 +34,7 @@ def _write(args: argparse.Namespace) -> int:
     samples = read_samples(source)
     first = next(samples, None)
     if first is None:
-        raise ValueError(f"{source}: no samples (an empty recording)")
+        raise InputError(f"{source}: no samples (an empty recording)")
     count = write_bag(itertools.chain([first], samples), out, manifest)
     print(f"wrote {count} samples from {source} -> {out}")
     return 0
@@ -86,11 +86,7 @@ def main(argv: list[str] | None = None) -> int:
     i.add_argument("bag")
     i.set_defaults(run=_info)
     args = parser.parse_args(argv)
-    try:
-        return args.run(args)
-    except (SchemaError, OSError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    return exit_status("bag", lambda: args.run(args), OSError, ValueError)
 
 
 if __name__ == "__main__":

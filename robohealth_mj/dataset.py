@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 
 from robohealth_mj.atomic import atomic_write_json
-from robohealth_mj.schema import SchemaError
+from robohealth_mj.errors import exit_status
 
 
 def resolve(paths: list[str]) -> list[Path]:
@@ -81,11 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     m.add_argument("--out", required=True)
     m.set_defaults(run=_merge)
     args = parser.parse_args(argv)
-    try:
-        return args.run(args)
-    except (SchemaError, FileNotFoundError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    return exit_status("dataset", lambda: args.run(args), ValueError)
 
 
 if __name__ == "__main__":

@@ -10,7 +10,7 @@ traceback.
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 from robohealth_mj.schema import SchemaError
@@ -23,10 +23,24 @@ class InputError(ValueError):
 USER_ERRORS = (InputError, SchemaError, FileNotFoundError, IsADirectoryError, PermissionError)
 
 
+def report(prog: str, exc: BaseException) -> int:
+    """Print the one line; the exit status for it."""
+    print(f"{prog}: error: {exc}", file=sys.stderr, flush=True)
+    return 2
+
+
 @contextmanager
 def one_line_errors(prog: str) -> Iterator[None]:
     try:
         yield
     except USER_ERRORS as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr, flush=True)
-        raise SystemExit(2) from None
+        raise SystemExit(report(prog, exc)) from None
+
+
+def exit_status(prog: str, run: Callable[[], int], *also: type[Exception]) -> int:
+    """``run()``'s status, or 2 after the one line for a user error (or one of ``also``): for
+    the argparse tools whose ``main`` returns a status."""
+    try:
+        return run()
+    except (*USER_ERRORS, *also) as exc:
+        return report(prog, exc)

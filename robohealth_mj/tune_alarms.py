@@ -12,8 +12,8 @@ names the policy that meets the targets with the lowest median latency to class.
 from __future__ import annotations
 
 import argparse
-import sys
 
+from robohealth_mj.errors import one_line_errors
 from robohealth_mj.runtime.alarm_sweep import choose, meets_targets, replay_decisions, sweep
 
 
@@ -29,12 +29,9 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--data", required=True, help="a selection session's graphs.jsonl")
     parser.add_argument("--healthy", help="a healthy-only selection session, for false alarms/h")
     args = parser.parse_args(argv)
-    try:
+    with one_line_errors("tune_alarms"):
         decisions = replay_decisions(args.model, args.data)
         healthy = replay_decisions(args.model, args.healthy) if args.healthy else None
-    except (OSError, ValueError) as exc:  # SchemaError, InputError and BagError among them
-        print(f"tune_alarms: error: {exc}", file=sys.stderr)
-        raise SystemExit(2) from None
     rows = sweep(decisions, healthy=healthy)
     print(
         f"selection: {args.data} (faults)"

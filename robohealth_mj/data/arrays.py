@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj.atomic import atomic_write_bytes
+from robohealth_mj.bags.reader import is_bag
 from robohealth_mj.data.jsonl import read_samples
 from robohealth_mj.errors import InputError
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, SCHEMA_VERSION
@@ -132,12 +133,6 @@ def load_recordings(paths: list[Path | str]) -> Recording:
     return Recording(
         run=np.concatenate(runs), run_ids=run_ids, sources=[str(p) for p in paths], **cat
     )
-
-
-def is_bag(path: Path) -> bool:
-    from robohealth_mj.bags.reader import is_bag as bag
-
-    return bag(path)
 
 
 def resolve_recordings(paths: list[str] | str) -> list[Path]:

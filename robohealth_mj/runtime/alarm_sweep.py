@@ -18,10 +18,11 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.data.arrays import load_recordings
-from robohealth_mj.runtime.alarms import STATE_NAMES, AlarmBank, AlarmPolicy
+from robohealth_mj.errors import InputError
+from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
-from robohealth_mj.runtime.runtime import HealthDiagnosis
+from robohealth_mj.runtime.runtime import HealthDiagnosis, decide
 from robohealth_mj.schema import FaultLabel
 
 
@@ -41,7 +42,7 @@ def replay_decisions(model: str | Path, recording: str | Path) -> Decisions:
     rec = load_recordings([Path(recording)])
     fleet = FleetRuntime(model)
     if fleet.engine is None:
-        raise ValueError(fleet.problem)
+        raise InputError(fleet.problem)
     slot = fleet.register([str(recording)])
     n = len(rec)
     decided = np.zeros(n, bool)
@@ -71,17 +72,14 @@ def evaluate_policy(d: Decisions, policy: AlarmPolicy) -> dict[str, Any]:
     bank = AlarmBank(policy, d.joint_scores.shape[1], 1)
     ev = OnlineEvaluator(settle_ticks=d.window + policy.clear_after)
     slot = np.zeros(1, np.int64)
-    classes, joints = schema.FAULT_CLASSES, schema.JOINT_NAMES
+    classes, joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
     for k, truth in enumerate(d.truth):
         diag = HealthDiagnosis(stamp=0.0, stream_id="s", sample_index=k, valid=True)
         if d.decided[k]:
-            state, alarm, joint = bank.update(slot, d.probs[k : k + 1], d.joint_scores[k : k + 1])
-            c = int(d.probs[k].argmax())
-            diag.fault_class, diag.fault_present = classes[c], c != 0
-            diag.localised_joint = joints[int(d.joint_scores[k].argmax())] if c else None
-            diag.alarm = STATE_NAMES[int(state[0])]
-            if alarm[0] > 0:
-                diag.alarm_class, diag.alarm_joint = classes[int(alarm[0])], joints[int(joint[0])]
+            probs, scores = d.probs[k : k + 1], d.joint_scores[k : k + 1]
+            state, alarm, joint = bank.update(slot, probs, scores)
+            decide(diag, probs[0], scores[0], int(state[0]), int(alarm[0]), int(joint[0]),
+                   classes, joints)  # fmt: skip
         ev.update(truth, diag)
     return ev.result()
 

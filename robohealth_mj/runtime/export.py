@@ -22,7 +22,7 @@ from torch import nn
 
 from robohealth_mj import schema
 from robohealth_mj.atomic import atomic_write_bytes
-from robohealth_mj.data.arrays import load_recordings
+from robohealth_mj.data.arrays import Recording, load_recordings
 from robohealth_mj.data.windows import make_windows
 from robohealth_mj.errors import InputError
 from robohealth_mj.learn.checkpoint import (
@@ -69,26 +69,29 @@ def file_fingerprint(path: Path | str) -> str:
     return digest.hexdigest()[:16]
 
 
-def heldout_windows(ckpt: dict[str, Any], data: str | list[str] | None, count: int) -> torch.Tensor:
-    """Up to ``count`` raw windows ``[K, W, 12, F]`` spread over a held-out recording."""
+def heldout_recording(ckpt: dict[str, Any], data: str | list[str] | None) -> Recording:
+    """The held-out data the parity checks run on (``data`` or the checkpoint's own)."""
     data = data or ckpt["config"].get("data", {}).get("evaluate", {}).get("heldout")
     if not data:
         raise ValueError("no held-out data for the parity check: pass data=PATH")
     files = expand_paths(data)
     for f in files:
         check_schema(ckpt, str(f))
-    rec = load_recordings(files)
-    windows = make_windows(rec, int(ckpt["window"]))
+    return load_recordings(files)
+
+
+def heldout_windows(rec: Recording, window: int, count: int) -> torch.Tensor:
+    """Up to ``count`` raw windows ``[K, W, 12, F]`` spread over a held-out recording."""
+    windows = make_windows(rec, window)
     pick = np.linspace(0, len(windows) - 1, min(count, len(windows))).astype(int)
     idx = windows.start[pick][:, None] + np.arange(windows.window)
     return torch.from_numpy(rec.x[idx])
 
 
-def heldout_run(ckpt: dict[str, Any], data: str | list[str] | None, count: int) -> torch.Tensor:
+def heldout_run(rec: Recording, count: int) -> torch.Tensor:
     """The first ``count`` consecutive raw snapshots ``[count, 12, F]`` of one held-out run."""
-    data = data or ckpt["config"].get("data", {}).get("evaluate", {}).get("heldout")
-    rec = load_recordings(expand_paths(data))
-    same = (rec.run == rec.run[0]) & (np.diff(rec.sample_index, prepend=-1) == 1)
+    step = np.diff(rec.sample_index, prepend=rec.sample_index[0] - 1)
+    same = (rec.run == rec.run[0]) & (step == 1)
     length = int(np.argmin(same)) if not same.all() else len(rec)
     if length < count:
         raise ValueError(f"held-out data has no run of {count} consecutive samples")
@@ -185,7 +188,9 @@ def export_checkpoint(
         )
     graph = graph_from_checkpoint(ckpt)
     pre = RawInput(ckpt["norm_mean"], ckpt["norm_std"], graph.coupling).eval()
-    windows = heldout_windows(ckpt, data, parity_windows)
+    window = int(ckpt["window"])
+    rec = heldout_recording(ckpt, data)
+    windows = heldout_windows(rec, window, parity_windows)
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
@@ -200,9 +205,7 @@ def export_checkpoint(
             f"> {PARITY_TOLERANCE} on {len(windows)} held-out windows"
         )
     incremental = (
-        incremental_graphs(
-            model, pre, heldout_run(ckpt, data, 2 * int(ckpt["window"]) + 64), int(ckpt["window"])
-        )
+        incremental_graphs(model, pre, heldout_run(rec, 2 * window + 64), window)
         if supports_incremental(model)
         else {}
     )

@@ -65,19 +65,35 @@ def diagnoses(fleet: FleetRuntime, result: TickResult) -> list[HealthDiagnosis]:
             reason=result.reasons.get(k),
         )
         if status == DECIDED:
-            probs, scores = result.probs[k], result.joint_scores[k]
-            c = int(probs.argmax())
-            d.fault_class, d.fault_present, d.confidence = fleet.classes[c], c != 0, float(probs[c])
-            d.class_probabilities = {n: float(p) for n, p in zip(fleet.classes, probs, strict=True)}
-            d.joint_scores = {n: float(v) for n, v in zip(fleet.joints, scores, strict=True)}
-            d.localised_joint = fleet.joints[int(scores.argmax())] if d.fault_present else None
+            decide(
+                d, result.probs[k], result.joint_scores[k], int(result.alarm[k]),
+                int(result.alarm_class[k]), int(result.alarm_joint[k]), fleet.classes, fleet.joints,
+            )  # fmt: skip
             d.inference_latency_ms = result.inference_ms
-            d.alarm = STATE_NAMES[int(result.alarm[k])]
-            if result.alarm_class[k] > 0:
-                d.alarm_class = fleet.classes[int(result.alarm_class[k])]
-                d.alarm_joint = fleet.joints[int(result.alarm_joint[k])]
         out.append(d)
     return out
+
+
+def decide(
+    d: HealthDiagnosis,
+    probs: np.ndarray,
+    scores: np.ndarray,
+    state: int,
+    alarm_class: int,
+    alarm_joint: int,
+    classes: list[str],
+    joints: list[str],
+) -> None:
+    """Fill ``d`` with one decided tick: class probabilities ``[C]``, joint scores ``[J]`` and
+    the stream's alarm (state, class index or 0, joint index)."""
+    c = int(probs.argmax())
+    d.fault_class, d.fault_present, d.confidence = classes[c], c != 0, float(probs[c])
+    d.class_probabilities = {n: float(p) for n, p in zip(classes, probs, strict=True)}
+    d.joint_scores = {n: float(v) for n, v in zip(joints, scores, strict=True)}
+    d.localised_joint = joints[int(scores.argmax())] if d.fault_present else None
+    d.alarm = STATE_NAMES[state]
+    if alarm_class > 0:
+        d.alarm_class, d.alarm_joint = classes[alarm_class], joints[alarm_joint]
 
 
 class ModelRuntime:
