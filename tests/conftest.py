@@ -1,4 +1,9 @@
-"""Shared fixtures: configs composed the way the entry points compose them, on tiny sizes."""
+"""Shared fixtures: configs composed the way the entry points compose them, on tiny sizes.
+
+``ROBOHEALTH_TEST_CACHE=DIR`` keeps the recorded and trained fixtures in ``DIR`` between pytest
+sessions (the mutation tester starts one session per mutant; see the README). Without it, every
+session builds them afresh in its own temporary directory.
+"""
 
 from __future__ import annotations
 
@@ -6,11 +11,14 @@ import os
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # headless rendering; must precede importing mujoco
 
+import json
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
 from robohealth_mj.config import compose_config
+from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.sim.model import build_model
 
 
@@ -38,6 +46,21 @@ FAST = [  # a session of every fault class at one severity on two joints: second
     "session.passes=1",
 ]
 
+LEARNABLE = [  # three faults that show with the joint at rest, on three joints, 3 s each
+    "session.progress=false",
+    "faults.schedule.fault_s=3.0",
+    "faults.schedule.healthy_s=1.5",
+    "faults.schedule.severities=[0.9]",
+    "faults.schedule.classes=[jam,backlash,sensor_drift]",
+    "faults.schedule.joints=[shoulder_lift,elbow,wrist_2]",
+    "session.passes=2",
+]
+LEARNABLE_SESSIONS = {**{f"train_{s}": s for s in range(1, 5)}, "heldout": 99}
+
+# The alarm policy the runtime tests use with the deployed model: its fault decisions reach this
+# confidence for a few ticks running in most episodes of the held-out session.
+DECIDING_ALARM = AlarmPolicy(raise_after=3, clear_after=4, min_confidence=0.8)
+
 
 @pytest.fixture(scope="session")
 def fast_session() -> list[str]:
@@ -46,33 +69,90 @@ def fast_session() -> list[str]:
 
 
 @pytest.fixture(scope="session")
-def deployed(tmp_path_factory) -> dict[str, Path]:
-    """A tiny trained model (structural and harness) exported to ONNX, and its held-out data."""
-    from robohealth_mj.recorder import GRAPHS_FILE, record_session
+def deciding_alarm() -> AlarmPolicy:
+    return DECIDING_ALARM
+
+
+def cached(tmp_path_factory, name: str, build: Callable[[Path], dict]) -> dict:
+    """``build(root)`` once per session, or once per ``ROBOHEALTH_TEST_CACHE`` directory: its
+    JSON-able result is kept beside what it wrote, and a later session reuses both."""
+    cache = os.environ.get("ROBOHEALTH_TEST_CACHE")
+    if not cache:
+        return build(tmp_path_factory.mktemp(name))
+    root = Path(cache) / name
+    done = root / "fixture.json"
+    if done.is_file():
+        return json.loads(done.read_text())
+    root.mkdir(parents=True, exist_ok=True)
+    result = build(root)
+    done.write_text(json.dumps(result))
+    return result
+
+
+def _recorder(overrides: list[str], sessions: dict[str, int]) -> Callable[[Path], dict]:
+    def record(root: Path) -> dict:
+        from robohealth_mj.recorder import record_session
+
+        for name, seed in sessions.items():
+            record_session(compose_config("record", [*overrides, f"seed={seed}"]), root / name)
+        return {"root": str(root)}
+
+    return record
+
+
+@pytest.fixture(scope="session")
+def tiny_corpus(tmp_path_factory) -> Path:
+    """Three short training sessions and a held-out one, each covering every fault class."""
+    sessions = {"train_a": 1, "train_b": 2, "train_c": 3, "heldout": 4}
+    return Path(cached(tmp_path_factory, "tiny", _recorder(FAST, sessions))["root"])
+
+
+@pytest.fixture(scope="session")
+def learnable_corpus(tmp_path_factory) -> Path:
+    """Four short training sessions and a held-out one (seed 99): jam, backlash and sensor drift
+    at severity 0.9 on three joints, which a few epochs learn to tell apart."""
+    recorder = _recorder(LEARNABLE, LEARNABLE_SESSIONS)
+    return Path(cached(tmp_path_factory, "learnable", recorder)["root"])
+
+
+def _train_and_export(corpus: Path, root: Path) -> dict:
     from robohealth_mj.runtime.export import export_checkpoint
     from robohealth_mj.train import run
 
-    root = tmp_path_factory.mktemp("deploy")
-    for name, seed in (("train_a", 1), ("train_b", 2), ("train_c", 3), ("heldout", 4)):
-        record_session(compose_config("record", [*FAST, f"seed={seed}"]), root / name)
-    paths = {"root": root, "heldout": root / "heldout" / GRAPHS_FILE}
-    for graph in ("structural", "harness"):
+    paths = {"root": str(corpus), "heldout": str(corpus / "heldout" / "graphs.jsonl")}
+    models = {  # structural: a model that decides; harness: the headline variant, barely trained
+        "structural": ["variant=stgnn_fixed", "model.hidden=32", "trainer.epochs=8"],
+        "harness": ["variant=anomaly_residual", "model.hidden=8", "trainer.epochs=1"],
+    }
+    for graph, overrides in models.items():
         cfg = compose_config(
             "train",
             [
-                f"data.train=[{root}/train_*]",
-                f"data.evaluate.heldout={root}/heldout",
+                f"data.train=[{corpus}/train_*]",
+                f"data.evaluate.heldout={corpus}/heldout",
                 "data.evaluate.probe=null",
-                "trainer.epochs=1",
                 "trainer.progress=false",
-                "model.hidden=8",
                 "window=8",
-                "variant=anomaly_residual",
                 f"graph={graph}",
+                *overrides,
             ],
         )
         run(cfg, root / graph)
-        paths[f"{graph}_ckpt"] = root / graph / "best.ckpt"
+        paths[f"{graph}_ckpt"] = str(root / graph / "best.ckpt")
         result = export_checkpoint(root / graph / "best.ckpt", root / graph / "model.onnx")
-        paths[f"{graph}_onnx"] = Path(result["path"])
+        paths[f"{graph}_onnx"] = result["path"]
     return paths
+
+
+@pytest.fixture(scope="session")
+def deployed(tmp_path_factory, learnable_corpus) -> dict[str, Path]:
+    """Two trained models exported to ONNX, and their held-out data (``learnable_corpus``).
+
+    ``structural`` (``stgnn_fixed``, 8 epochs) decides: on the held-out session it calls faults
+    with the right class and joint and, under :data:`DECIDING_ALARM`, raises and clears alarms, so
+    the runtime, monitor, alarm and bag tests run the fault path. ``harness``
+    (``anomaly_residual`` on the unknown-placement graph, 1 epoch) covers the coupling model."""
+    paths = cached(
+        tmp_path_factory, "deploy", lambda root: _train_and_export(learnable_corpus, root)
+    )
+    return {key: Path(value) for key, value in paths.items()}

@@ -11,15 +11,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from robohealth_mj import schema
 from robohealth_mj.bag import main as bag_main
 from robohealth_mj.bags.messages import MessageFactory, stamp_ns, typestore
 from robohealth_mj.bags.reader import BagError, read_bag_samples
 from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.bags.writer import BagWriter
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.jsonl import read_samples
 from robohealth_mj.dataset import main as dataset_main
 from robohealth_mj.learn.checkpoint import checkpoint_digest
 from robohealth_mj.monitor import main as monitor_main
+from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 
 
 @pytest.fixture(scope="module")
@@ -118,37 +121,130 @@ def test_a_bad_bag_names_its_topic_and_stamp(deployed, tmp_path, edit, message):
     assert dataset_main(["summarize", str(out)]) == 2
 
 
-def test_monitor_replays_a_bag_and_writes_its_diagnoses_beside_the_topics(deployed, bag, tmp_path):
+def _diagnoses(path: Path) -> list[tuple]:
+    """``(stamp, level, message, fault_class, joint, alarm, confidence)`` per /health_diagnosis."""
     from rosbags.rosbag2 import Reader
 
-    def diagnoses(path: Path) -> list[tuple]:
-        store = typestore()
-        with Reader(path) as reader:
-            conns = [c for c in reader.connections if c.topic == "/health_diagnosis"]
-            out = []
-            for _, stamp, raw in reader.messages(connections=conns):
-                status = store.deserialize_cdr(raw, conns[0].msgtype).status[0]
-                values = {kv.key: kv.value for kv in status.values}
-                out.append((stamp, status.level, status.message, values["fault_class"],
-                            values["joint"], values["alarm"], values["confidence"]))  # fmt: skip
-            return out
+    store = typestore()
+    with Reader(path) as reader:
+        conns = [c for c in reader.connections if c.topic == "/health_diagnosis"]
+        out = []
+        for _, stamp, raw in reader.messages(connections=conns):
+            status = store.deserialize_cdr(raw, conns[0].msgtype).status[0]
+            values = {kv.key: kv.value for kv in status.values}
+            out.append((stamp, int(status.level), status.message, values["fault_class"],
+                        values["joint"], values["alarm"], values["confidence"]))  # fmt: skip
+        return out
 
-    model = deployed["structural_onnx"]
-    for source, out in ((deployed["heldout"], tmp_path / "a"), (bag, tmp_path / "b")):
-        monitor_main([f"model={model}", "source=replay", f"file={source}", "quiet=true",
-                      f"bag_out={out}"])  # fmt: skip
-    from_jsonl, from_bag = diagnoses(tmp_path / "a"), diagnoses(tmp_path / "b")
+
+OK, WARN, ERROR = 0, 1, 2  # diagnostic_msgs/DiagnosticStatus levels
+
+
+def test_diagnosis_levels_follow_the_alarm(tmp_path):
+    """ERROR while an alarm is up; WARN for a fault decided without one or an invalid sample;
+    OK for healthy or undecided ticks (the README's table)."""
+
+    def diag(**kw) -> HealthDiagnosis:
+        return HealthDiagnosis(**{"stamp": 0.05 * (len(cases) + 1), "stream_id": "arm",
+                                  "sample_index": len(cases), "valid": True, **kw})  # fmt: skip
+
+    cases: list[tuple[HealthDiagnosis, int, str]] = []
+    for kw, level, message in [
+        ({"fault_class": "none", "confidence": 0.9}, OK, "healthy"),
+        ({"fault_class": None, "reason": "warming up"}, OK, "no decision: warming up"),
+        ({"fault_class": "jam", "fault_present": True, "localised_joint": "elbow"}, WARN,
+         "jam @ elbow (no alarm)"),
+        ({"valid": False, "reason": "NaN"}, WARN, "invalid sample: NaN"),
+        ({"fault_class": "jam", "fault_present": True, "alarm": "raised", "alarm_class": "jam",
+          "alarm_joint": "elbow"}, ERROR, "ALARM jam @ elbow (raised)"),
+        ({"fault_class": "none", "alarm": "held", "alarm_class": "jam", "alarm_joint": "elbow"},
+         ERROR, "ALARM jam @ elbow (held)"),
+    ]:  # fmt: skip
+        cases.append((diag(**kw), level, message))
+    with BagWriter(tmp_path / "levels") as writer:
+        for d, _, _ in cases:
+            writer.write_diagnosis(d, list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES))
+    got = _diagnoses(tmp_path / "levels")
+    assert [(g[1], g[2]) for g in got] == [(level, message) for _, level, message in cases]
+
+
+@pytest.fixture(scope="module")
+def diagnosed(deployed, deciding_alarm, bag, tmp_path_factory) -> dict[str, Path]:
+    """The monitor's replays of the held-out JSONL and of its bag, each written to a bag."""
+    root = tmp_path_factory.mktemp("diagnosed")
+    alarm = [f"alarm.{k}={getattr(deciding_alarm, k)}" for k in ("raise_after", "clear_after",
+             "min_confidence")]  # fmt: skip
+    out = {"jsonl": root / "from_jsonl", "bag": root / "from_bag"}
+    for source, target in ((deployed["heldout"], out["jsonl"]), (bag, out["bag"])):
+        monitor_main([f"model={deployed['structural_onnx']}", "source=replay", f"file={source}",
+                      "quiet=true", f"bag_out={target}", *alarm])  # fmt: skip
+    return out
+
+
+def test_monitor_replays_a_bag_and_writes_its_diagnoses_beside_the_topics(
+    deployed, deciding_alarm, bag, diagnosed
+):
+    from rosbags.rosbag2 import Reader
+
+    from_jsonl, from_bag = _diagnoses(diagnosed["jsonl"]), _diagnoses(diagnosed["bag"])
     assert len(from_bag) == len(list(read_samples(bag))) and from_jsonl == from_bag
-    assert {d[1] for d in from_bag} >= {0}  # OK levels at least; the tiny model may not alarm
-    with Reader(tmp_path / "b") as reader:
+    # the levels are the runtime's alarms: ERROR exactly while one is up
+    runtime = ModelRuntime(deployed["structural_onnx"], alarm=deciding_alarm)
+    expected = []
+    for sample in read_samples(deployed["heldout"]):
+        d = runtime.process("arm1", sample)
+        expected.append(ERROR if d.alarm_class else WARN if d.fault_present else OK)
+    levels = [d[1] for d in from_bag]
+    assert levels == expected
+    assert levels.count(ERROR) > 100 and levels.count(WARN) > 10 and levels.count(OK) > 100
+    with Reader(diagnosed["bag"]) as reader:
         assert {c.topic for c in reader.connections} >= set(BagTopics.load().sample_topics())
+
+
+def test_bag_info_lists_topics_types_counts_and_the_manifest(bag, diagnosed, capsys):
+    n = len(list(read_samples(bag)))
+    assert bag_main(["info", str(bag)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    topics = BagTopics.load().sample_topics()
+    assert lines[0].startswith(f"{bag}: {n * len(topics)} messages")
+    rows = {line.split()[0]: line.split()[1:] for line in lines[1:-1]}
+    assert rows == {topic: [kind, str(n)] for topic, kind in topics.items()}
+    assert lines[-1].startswith("  manifest: run ur5e-s99-") and lines[-1].endswith("seed 99")
+    assert bag_main(["info", str(diagnosed["bag"])]) == 0
+    out = capsys.readouterr().out
+    assert "/health_diagnosis" in out and f"diagnostic_msgs/msg/DiagnosticArray {n}" in " ".join(
+        out.split()
+    )
+    assert bag_main(["info", str(bag.parent)]) == 2  # not a bag: one line, status 2
+    assert "not a rosbag2 directory" in capsys.readouterr().err
+
+
+def test_bag_plot_draws_truth_and_alarms_on_one_timeline(diagnosed, tmp_path):
+    from PIL import Image
+
+    png = tmp_path / "timeline.png"
+    assert bag_main(["plot", str(diagnosed["bag"]), "--out", str(png)]) == 0
+    image = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    assert image.shape == (572, 1210, 3)
+
+    def share(rows: slice, rgb: tuple[float, float, float]) -> float:
+        """Share of the pixels in ``rows`` painted in a class's band colour (alpha 0.8)."""
+        target = np.round((0.8 * np.array(rgb) + 0.2) * 255)
+        return float((np.abs(image[rows] - target).max(axis=-1) <= 3).mean())
+
+    truth_row, alarm_row = slice(60, 180), slice(210, 320)
+    backlash, jam = (1.0, 0.498, 0.055), (0.839, 0.153, 0.157)  # tab10 colours 1 and 3
+    for colour in (backlash, jam):
+        assert share(truth_row, colour) > 0.02 and share(alarm_row, colour) > 0.02
+    # a bag whose diagnoses are missing cannot be plotted: one line, status 2
+    assert bag_main(["plot", str(tmp_path / "nothing"), "--out", str(png)]) == 2
 
 
 def test_training_on_bags_equals_training_on_their_jsonl(deployed, bag, tmp_path):
     from robohealth_mj.config import compose_config
     from robohealth_mj.train import run
 
-    names = ("train_a", "train_b", "train_c")
+    names = ("train_1", "train_2", "train_3")
     bags = [tmp_path / f"{name}_bag" for name in names]
     for name, out in zip(names, bags, strict=True):
         assert bag_main(["write", str(deployed["root"] / name), "--out", str(out)]) == 0
@@ -192,6 +288,7 @@ def bad_files(deployed, tmp_path_factory) -> dict[str, Path]:
         "empty_ckpt": root / "empty.ckpt",
         "truncated_ckpt": root / "truncated.ckpt",
         "tampered_ckpt": root / "tampered.ckpt",
+        "unchecked_ckpt": root / "unchecked.ckpt",
         "schema_ckpt": root / "schema.ckpt",
         "topology_ckpt": root / "topology.ckpt",
         "not_onnx": root / "not.onnx",
@@ -205,6 +302,9 @@ def bad_files(deployed, tmp_path_factory) -> dict[str, Path]:
     middle = len(tampered) // 2
     tampered[middle : middle + 64] = b"\x00" * 64
     files["tampered_ckpt"].write_bytes(bytes(tampered))
+    ckpt = torch.load(deployed["structural_ckpt"], weights_only=True)
+    del ckpt["sha256"]  # the checksum removed, the rest intact
+    torch.save(ckpt, files["unchecked_ckpt"])
     ckpt = torch.load(deployed["structural_ckpt"], weights_only=True)
     ckpt["schema"] = {**ckpt["schema"], "version": "1.0"}
     ckpt["sha256"] = checkpoint_digest(ckpt)  # a sound file, written for another schema
@@ -229,6 +329,7 @@ def bad_files(deployed, tmp_path_factory) -> dict[str, Path]:
         ("empty_ckpt", "evaluate ckpt={f} data={heldout}", ["empty.ckpt", "empty file"]),
         ("truncated_ckpt", "evaluate ckpt={f} data={heldout}", ["truncated.ckpt", "unreadable"]),
         ("tampered_ckpt", "export ckpt={f}", ["tampered.ckpt", "altered"]),
+        ("unchecked_ckpt", "evaluate ckpt={f} data={heldout}", ["unchecked.ckpt", "'sha256'"]),
         ("schema_ckpt", "evaluate ckpt={f} data={heldout}", ["schema.ckpt", "schema 2.0", "1.0"]),
         ("topology_ckpt", "export ckpt={f}", ["topology.ckpt", "topology"]),
         ("not_onnx", "monitor model={f} source=replay file={heldout}", ["not.onnx", "not an ONNX"]),

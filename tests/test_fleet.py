@@ -24,10 +24,10 @@ TOLERANCE = 1e-4
 
 
 def _replay(fleet: FleetRuntime, x: np.ndarray, streams: int, ticks: int, skip: dict | None = None):
-    """Stream ``k`` replays ``x`` from offset ``37 k``; ``skip`` {tick: stream} drops a sample
-    (a gap). Returns probs [ticks, streams, C] (NaN where undecided) and the windows' starts."""
+    """Stream ``k`` replays ``x`` from offset ``37 k`` (wrapped to fit); ``skip`` {tick: stream}
+    drops a sample (a gap). Returns probs [ticks, streams, C] (NaN where undecided)."""
     slots = fleet.register([f"s{k}" for k in range(streams)])
-    offsets = 37 * np.arange(streams)
+    offsets = (37 * np.arange(streams)) % (len(x) - ticks)
     probs = np.full((ticks, streams, len(fleet.classes)), np.nan, np.float32)
     for t in range(ticks):
         send = np.array([skip is None or skip.get(t) != k for k in range(streams)])
@@ -240,14 +240,119 @@ def test_online_alarm_metrics_on_a_scripted_stream_with_known_onsets():
 
 def test_a_short_soak_flags_every_bad_row_and_keeps_the_healthy_streams(deployed):
     rec = load_recordings([deployed["heldout"]])
-    fleet = FleetRuntime(deployed["structural_onnx"], capacity=24, max_streams=24, shards=2)
-    report = soak(fleet, rec.x, 24, 330, bad_share=0.25).summary()
+    streams = 140  # enough that the two shards engage (64 rows a shard at least)
+    fleet = FleetRuntime(deployed["structural_onnx"], capacity=streams, max_streams=streams,
+                         shards=2)  # fmt: skip
+    calls = []
+    infer = fleet.engine.infer
+    fleet.engine.infer = lambda slots: calls.append(len(slots)) or infer(slots)
+    report = soak(fleet, rec.x, streams, 120, bad_share=0.25).summary()
     assert all(report["injected"][k] > 0 for k in KINDS), report["injected"]
     assert sum(report["missed"].values()) == 0, report["missed"]
     assert report["healthy_undecided"] == 0
-    assert fleet.capacity == 24  # state arrays allocated once
+    assert fleet.capacity == streams  # state arrays allocated once
+    assert max(calls) < streams - 20 and len(calls) > 120  # two model calls per full tick
+
+
+def test_sharded_steps_decide_as_one_shard_does(deployed):
+    rec = load_recordings([deployed["heldout"]])
+    one = FleetRuntime(deployed["structural_onnx"])
+    two = FleetRuntime(deployed["structural_onnx"], shards=2)
+    a, b = _replay(one, rec.x, 130, 12), _replay(two, rec.x, 130, 12)
+    assert (~np.isnan(a)).sum() == 5 * 130 * 7  # every stream decided on the last 5 ticks
+    np.testing.assert_allclose(a, b, atol=1e-6)
+    two.close()
+
+
+def test_idle_streams_are_released_and_their_slots_reused(deployed):
+    rec = load_recordings([deployed["heldout"]])
+    fleet = FleetRuntime(deployed["structural_onnx"], idle_ticks=30)
+    slots = fleet.register(["a", "b"])
+    for t in range(10):
+        fleet.step(slots, [t, t], [0.05 * (t + 1)] * 2, rec.x[t : t + 2])
+    for t in range(10, 40):  # 'a' falls silent at tick 10
+        fleet.step(slots[1:], [t], [0.05 * (t + 1)], rec.x[t : t + 1])
+    assert fleet.streams == ["a", "b"]  # silent for 30 ticks: not yet idle
+    for t in range(40, 60):
+        r = fleet.step(slots[1:], [t], [0.05 * (t + 1)], rec.x[t : t + 1])
+        assert r.status[0] == DECIDED
+    assert fleet.streams == ["b"]  # released at the once-a-second sweep after 30 idle ticks
+    (c,) = fleet.register(["c"])
+    assert c == slots[0]  # the freed slot is reused, with a fresh window and sample index
+    r = fleet.step([c], [0], [0.05], rec.x[:1])
+    assert r.status[0] == WARMING and r.reasons[0].startswith("warming up")
 
 
 def test_monitor_refuses_nonsense_alarm_settings(deployed):
     with pytest.raises(SystemExit, match="min_confidence"):
         monitor_main([f"model={deployed['structural_onnx']}", "alarm.min_confidence=2"])
+
+
+def _table(printed: str) -> list[dict]:
+    """The policy rows of tune_alarms' markdown table."""
+    rows = []
+    for line in printed.splitlines():
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if len(cells) == 9 and cells[0].isdigit():
+            number = lambda c: None if c == "–" else float(c)  # noqa: E731
+            rows.append({
+                "raise_after": int(cells[0]), "min_confidence": float(cells[2]),
+                "detection_rate": number(cells[3]), "false_alarms_per_hour": number(cells[5]),
+                "class_latency_s_median": number(cells[6]), "meets": cells[8] == "yes",
+            })  # fmt: skip
+    return rows
+
+
+def test_tune_alarms_sweeps_the_grid_and_chooses_the_fastest_policy_meeting_the_targets(
+    deployed, record_cfg, tmp_path, capsys
+):
+    from robohealth_mj.recorder import record_session
+    from robohealth_mj.runtime.alarm_sweep import GRID, TARGETS
+    from robohealth_mj.tune_alarms import main as tune_main
+
+    healthy = tmp_path / "healthy"
+    record_session(record_cfg("faults=none", "session.duration_s=60", "seed=11"), healthy)
+    args = ["--model", str(deployed["structural_onnx"]), "--data", str(deployed["heldout"])]
+    best = tune_main(args)
+    rows = _table(capsys.readouterr().out)
+    assert len(rows) == len(GRID["raise_after"]) * len(GRID["min_confidence"]) == 16
+    # a stricter policy never detects more: more votes needed, or more confidence per vote
+    by = {(r["raise_after"], r["min_confidence"]): r["detection_rate"] for r in rows}
+    for (n, c), rate in by.items():
+        for n2, c2 in by:
+            if n2 >= n and c2 >= c:
+                assert by[(n2, c2)] <= rate + 1e-9, ((n, c), (n2, c2))
+    assert by[(6, 0.8)] > by[(20, 0.97)]
+    good = [r for r in rows if r["meets"]]
+    for r in good:
+        assert r["detection_rate"] >= TARGETS["detection_rate"]
+    if good:
+        fastest = min(r["class_latency_s_median"] for r in good)
+        assert best["class_latency_s_median"] == pytest.approx(fastest, abs=1e-3)
+    else:  # nothing meets the targets: the policy with the fewest false alarms per hour
+        assert best["false_alarms_per_hour"] == min(r["false_alarms_per_hour"] for r in rows)
+    # healthy running adds hours to the false-alarm rate, and the table says so
+    again = tune_main([*args, "--healthy", str(healthy / "graphs.jsonl")])
+    assert "(healthy); 0.02 h of settled healthy running" in capsys.readouterr().out
+    minute = (1200 - 8 - 10) * 0.05 / 3600  # after the window fills and the clear delay passes
+    assert again["healthy_hours"] == pytest.approx(best["healthy_hours"] + minute, abs=3e-4)
+
+
+def test_choose_prefers_the_fastest_policy_that_meets_every_target():
+    from robohealth_mj.runtime.alarm_sweep import choose, meets_targets
+
+    def row(name, detection, per_hour, rate, latency):
+        return {"name": name, "detection_rate": detection, "false_alarms_per_hour": per_hour,
+                "false_alarm_rate": rate, "class_latency_s_median": latency,
+                "joint_latency_s_median": latency}  # fmt: skip
+
+    rows = [
+        row("slow", 0.99, 0.5, 0.001, 2.0),
+        row("fast", 0.96, 1.5, 0.005, 0.6),
+        row("noisy", 0.99, 3.0, 0.005, 0.2),  # too many false alarms per hour
+        row("blind", 0.90, 0.0, 0.0, 0.1),  # detects too little
+        row("jumpy", 0.99, 1.0, 0.02, 0.1),  # too many alarmed healthy ticks
+    ]
+    assert [meets_targets(r) for r in rows] == [True, True, False, False, False]
+    assert choose(rows)["name"] == "fast"
+    assert choose(rows[2:])["name"] == "blind"  # none meets them: fewest false alarms

@@ -14,7 +14,10 @@ from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.windows import make_windows
 from robohealth_mj.learn.checkpoint import load_checkpoint, model_from_checkpoint
 from robohealth_mj.monitor import main as monitor_main
+from robohealth_mj.runtime.alarm_sweep import evaluate_policy, replay_decisions
+from robohealth_mj.runtime.alarms import CLEARED, HELD, RAISED
 from robohealth_mj.runtime.export import RawInput, export_checkpoint, read_metadata
+from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 from robohealth_mj.schema import FaultLabel
@@ -53,6 +56,30 @@ def test_export_matches_pytorch_on_raw_windows_and_carries_metadata(deployed, gr
     np.testing.assert_allclose(got, expected, atol=1e-4)
 
 
+def test_export_refuses_an_onnx_file_that_fails_its_parity_check(deployed, tmp_path, monkeypatch):
+    """The exported graph is checked against PyTorch on held-out windows; here the exporter is
+    handed a network whose weights differ slightly, so the check must refuse it and leave
+    nothing behind."""
+    import copy
+
+    from robohealth_mj.runtime import export as export_module
+
+    real_export = export_module.export_onnx
+
+    def export_a_drifted_copy(model, examples, path, pre=None):
+        drifted = copy.deepcopy(model)
+        with torch.no_grad():
+            for p in drifted.parameters():
+                p.add_(0.05 * torch.randn_like(p))
+        return real_export(drifted, examples, path, pre=pre)
+
+    monkeypatch.setattr(export_module, "export_onnx", export_a_drifted_copy)
+    out = tmp_path / "model.onnx"
+    with pytest.raises(RuntimeError, match="ONNX parity check failed"):
+        export_checkpoint(deployed["structural_ckpt"], out)
+    assert list(tmp_path.iterdir()) == []  # no model, no temporary file, no side data
+
+
 def test_export_fails_loudly_without_held_out_data(deployed, tmp_path):
     with pytest.raises(FileNotFoundError):
         export_checkpoint(
@@ -74,13 +101,65 @@ def test_runtime_on_a_replay_decides_as_batch_evaluation_does(deployed):
     idx = windows.start[:, None] + np.arange(8)
     with torch.no_grad():
         out = model(torch.from_numpy(x[idx]).float())
+    faults = right = 0
     for k, end in enumerate(windows.end):
         d = diagnoses[end]
         probs = torch.softmax(out["class_logits"][k], 0).numpy()
         assert d.fault_class == schema.FAULT_CLASSES[int(probs.argmax())]
+        assert d.confidence == pytest.approx(float(probs.max()), abs=1e-5)
         np.testing.assert_allclose(list(d.class_probabilities.values()), probs, atol=1e-5)
         if d.fault_present:
+            faults += 1
             assert d.localised_joint == schema.JOINT_NAMES[int(out["joint_logits"][k].argmax())]
+            right += d.localised_joint == schema.JOINT_NAMES[rec.fault_joint[end]]
+        else:
+            assert d.fault_class == "none" and d.localised_joint is None
+    # the fault path ran: the model calls faults on a good share of the windows, mostly at the
+    # faulted joint (three joints carry faults: chance is 1/3)
+    assert faults > 300 and right / faults > 0.6
+
+
+def _alarm_states(fleet: FleetRuntime, x: np.ndarray, streams: int) -> np.ndarray:
+    """Stream ``k`` replays ``x`` from offset ``200 k``; ``[ticks, streams, 3]`` of (alarm
+    state, alarmed class, alarmed joint) per decided tick (-9 where undecided)."""
+    slots = fleet.register([f"s{k}" for k in range(streams)])
+    ticks = len(x) - 200 * (streams - 1)
+    out = np.full((ticks, streams, 3), -9, np.int64)
+    for t in range(ticks):
+        r = fleet.step(slots, np.full(streams, t), np.full(streams, 0.05 * (t + 1)),
+                       x[200 * np.arange(streams) + t])  # fmt: skip
+        decided = r.status == DECIDED
+        out[t, decided] = np.stack([r.alarm, r.alarm_class, r.alarm_joint], 1)[decided]
+    return out
+
+
+def test_alarms_raise_hold_and_clear_through_the_fleet_runtime(deployed, deciding_alarm):
+    rec = load_recordings([deployed["heldout"]])
+    fleet = FleetRuntime(deployed["structural_onnx"], alarm=deciding_alarm)
+    states = _alarm_states(fleet, rec.x, 1)[:, 0]
+    decided = states[:, 0] >= 0
+    state, cls, joint = states[decided].T
+    raised = np.flatnonzero(state == RAISED)
+    assert len(raised) >= 8 and (state == CLEARED).sum() >= 5
+    # the state machine: an alarm is up (with a class and joint) from RAISED until CLEARED
+    up = False
+    for s, c, j in zip(state.tolist(), cls.tolist(), joint.tolist(), strict=True):
+        assert s != HELD or up, "held without an alarm"
+        assert s != CLEARED or up, "cleared without an alarm"
+        up = (up or s == RAISED) and s != CLEARED
+        assert (c > 0 and j >= 0) == up
+    # the alarms are right: the class and joint raised are the truth at that tick
+    ends = np.flatnonzero(decided)[raised]
+    right_class = cls[raised] == rec.fault_class[ends]
+    right_joint = joint[raised] == rec.fault_joint[ends]
+    assert right_class.mean() >= 0.7 and (right_class & right_joint).mean() >= 0.6
+    # each stream keeps its own alarm: interleaved streams alarm exactly as each alone
+    together = _alarm_states(FleetRuntime(deployed["structural_onnx"], alarm=deciding_alarm),
+                             rec.x, 3)  # fmt: skip
+    for k in range(3):
+        alone = _alarm_states(FleetRuntime(deployed["structural_onnx"], alarm=deciding_alarm),
+                              rec.x[200 * k :], 1)  # fmt: skip
+        np.testing.assert_array_equal(together[:, k], alone[: len(together), 0])
 
 
 def _line(deployed, k: int = 0) -> dict:
@@ -194,7 +273,14 @@ def test_online_evaluation_measures_detection_latency_on_a_scripted_stream():
     assert r["online_accuracy"] == pytest.approx((4 + 2 + 3 + 2) / decided)
 
 
-def test_monitor_replays_and_evaluates_with_its_alarm_settings(deployed, tmp_path, capsys):
+def _alarm_args(policy) -> list[str]:
+    return [f"alarm.{k}={getattr(policy, k)}" for k in ("raise_after", "clear_after",
+            "min_confidence")]  # fmt: skip
+
+
+def test_monitor_replays_and_evaluates_with_its_alarm_settings(
+    deployed, deciding_alarm, tmp_path, capsys
+):
     out = tmp_path / "online.json"
     result = monitor_main(
         [
@@ -202,14 +288,44 @@ def test_monitor_replays_and_evaluates_with_its_alarm_settings(deployed, tmp_pat
             "source=replay",
             f"file={deployed['heldout']}",
             "evaluate=true",
-            "alarm.raise_after=2",
-            "alarm.min_confidence=0.3",
+            *_alarm_args(deciding_alarm),
             f"out={out}",
         ]
     )
-    assert json.loads(out.read_text())["episodes"] == result["episodes"] > 0
-    assert result["alarm_policy"]["raise_after"] == 2
-    assert result["alarms"]["episodes"] == result["episodes"]
+    assert json.loads(out.read_text())["episodes"] == result["episodes"] == 18
+    assert result["alarm_policy"]["raise_after"] == deciding_alarm.raise_after
+    alarms = result["alarms"]
+    assert alarms["episodes"] == result["episodes"]
+    assert alarms["detected"] >= 10 and alarms["class_detected"] >= 10
     assert "| episodes of |" in out.with_suffix(".md").read_text()
     printed = capsys.readouterr().out
     assert "arm1:" in printed and "[truth:" in printed and "alarms: detected" in printed
+    raised = [line for line in printed.splitlines() if "ALARM RAISED" in line]
+    assert len(raised) >= 8 and sum("CLEARED" in line for line in printed.splitlines()) >= 5
+    # the alarm sweep replays the same policy over the same decisions to the same figures
+    swept = evaluate_policy(replay_decisions(deployed["structural_onnx"], deployed["heldout"]),
+                            deciding_alarm)  # fmt: skip
+    for key in ("alarms", "false_alarms", "settled_healthy_ticks", "online_accuracy"):
+        assert swept[key] == result[key], key
+
+
+def test_monitor_diagnoses_the_simulator_live(deployed, deciding_alarm, tmp_path, capsys):
+    """``source=sim``: the simulator's samples straight into the runtime, here with a backlash
+    at the elbow held on from the start (a fault the deployed model was trained on)."""
+    fault = "faults=fixed,faults.schedule.fault_class=backlash,faults.schedule.joint=elbow"
+    result = monitor_main(
+        [
+            f"model={deployed['structural_onnx']}",
+            "source=sim",
+            "duration_s=6",
+            f"sim_overrides=[seed=5,{fault},faults.schedule.severity=0.9]",
+            "evaluate=true",
+            *_alarm_args(deciding_alarm),
+            f"out={tmp_path / 'sim.json'}",
+        ]
+    )
+    assert result["source"] == "sim" and result["ticks"] == 120 and result["episodes"] == 1
+    assert result["alarms"]["class_detected"] == 1 and result["alarms"]["joint_detected"] == 1
+    assert result["alarms"]["class_latency_s_median"] <= 2.0
+    printed = capsys.readouterr().out
+    assert "ALARM RAISED backlash @ elbow" in printed and "[truth: backlash @ elbow" in printed

@@ -93,7 +93,8 @@ _REQUIRED = ("state_dict", "model_cfg", "variant", "schema", "graph", "window", 
 
 def load_checkpoint(path: Path | str) -> dict[str, Any]:
     """A checkpoint, or an :class:`InputError` naming the file and what is wrong with it (empty,
-    truncated or altered bytes, another format, a missing key, another schema or topology)."""
+    truncated or altered bytes, another format, a missing key or checksum, another schema or
+    topology)."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no checkpoint file")
@@ -112,7 +113,12 @@ def load_checkpoint(path: Path | str) -> dict[str, Any]:
     missing = [k for k in _REQUIRED if k not in ckpt]
     if missing:
         raise InputError(f"{path}: key '{missing[0]}' missing from the checkpoint")
-    if "sha256" in ckpt and checkpoint_digest(ckpt) != ckpt["sha256"]:
+    if "sha256" not in ckpt:  # a deleted checksum would otherwise let altered bytes load
+        raise InputError(
+            f"{path}: key 'sha256' missing: the checkpoint's checksum was removed, so its "
+            "contents cannot be trusted; re-save it with this version (train or export)"
+        )
+    if checkpoint_digest(ckpt) != ckpt["sha256"]:
         raise InputError(
             f"{path}: checksum mismatch: the checkpoint was altered after it was written"
         )
