@@ -3,6 +3,8 @@ diagnoses out, and one-line errors (exit status 2) for every kind of bad file.""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import subprocess
 import sys
@@ -10,13 +12,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from robohealth_mj import schema
 from robohealth_mj.bag import main as bag_main
 from robohealth_mj.bags.messages import MessageFactory, stamp_ns, typestore
-from robohealth_mj.bags.reader import BagError, read_bag_samples
+from robohealth_mj.bags.reader import BagError, bag_manifest, read_bag_samples
 from robohealth_mj.bags.topics import BagTopics
-from robohealth_mj.bags.writer import BagWriter
+from robohealth_mj.bags.writer import BagWriter, write_bag
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.jsonl import read_samples
 from robohealth_mj.dataset import main as dataset_main
@@ -28,13 +31,27 @@ from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 @pytest.fixture(scope="module")
 def bag(deployed, tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("bags") / "heldout_bag"
-    assert bag_main(["write", str(deployed["heldout"].parent), "--out", str(out)]) == 0
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert bag_main(["write", str(deployed["heldout"].parent), "--out", str(out)]) == 0
+    (out.parent / "printed.txt").write_text(printed.getvalue())
     return out
 
 
 def test_jsonl_to_bag_to_samples_is_the_identity(deployed, bag):
     a, b = list(read_samples(deployed["heldout"])), list(read_samples(bag))
     assert len(a) == len(b) > 100
+    printed = (bag.parent / "printed.txt").read_text()
+    assert printed.startswith(f"wrote {len(a)} samples from ")
+    # the session manifest rides along in the bag's metadata, as sorted JSON (same bytes)
+    manifest = json.loads((deployed["heldout"].parent / "manifest.json").read_text())
+    assert bag_manifest(bag) == manifest
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    assert info["storage_identifier"] == "mcap" and info["version"] == 8  # what Humble reads
+    custom = info["custom_data"]
+    assert custom["robohealth_mj.manifest"] == json.dumps(manifest, sort_keys=True)
+    assert custom["robohealth_mj.schema_version"] == "2.0"
+    assert not bag.with_name(bag.name + ".partial").exists()
     for x, y in zip(a, b, strict=True):
         np.testing.assert_allclose(y.x, x.x, rtol=0, atol=1e-6)
         assert (x.recording_run_id, x.sample_index, x.fault, x.segment) == (
@@ -71,6 +88,40 @@ def test_the_bag_is_standard_rosbag2_with_ros2_message_definitions(deployed, bag
                 assert header.stamp.sec * 10**9 + header.stamp.nanosec == stamp
             count += 1
     assert count == len(expected) * len(list(read_samples(bag)))
+
+
+def test_a_bag_is_written_to_the_topics_it_is_given(deployed, tmp_path):
+    from rosbags.rosbag2 import Reader
+
+    samples = list(read_samples(deployed["heldout"]))[:5]
+    topics = BagTopics.load(joint_states="/arm7/joint_states", imu="/arm7/{joint}/imu")
+    assert write_bag(samples, tmp_path / "ns", topics=topics) == 5
+    with Reader(tmp_path / "ns") as reader:
+        got = {c.topic: c.msgtype for c in reader.connections}
+        assert got == topics.sample_topics() and "/arm7/elbow/imu" in got
+    assert bag_manifest(tmp_path / "ns") is None  # no manifest given, none written
+    assert write_bag(samples, tmp_path / "m", manifest={"seed": 3, "run": "x"}) == 5
+    info = yaml.safe_load((tmp_path / "m" / "metadata.yaml").read_text())
+    stored = info["rosbag2_bagfile_information"]["custom_data"]["robohealth_mj.manifest"]
+    assert stored == '{"run": "x", "seed": 3}'  # sorted keys: the same manifest, the same bytes
+    assert len(list(read_bag_samples(tmp_path / "ns", topics))) == 5
+
+
+def test_a_bag_is_whole_or_absent(deployed, tmp_path):
+    """Written into ``<out>.partial`` and renamed on a clean close; a failure leaves nothing,
+    and a partial left by an earlier crash is cleared before writing."""
+    samples = list(read_samples(deployed["heldout"]))[:3]
+    out, partial = tmp_path / "b", tmp_path / "b.partial"
+    partial.mkdir()
+    (partial / "junk.mcap").write_bytes(b"from a crashed run")
+    with pytest.raises(RuntimeError, match="stop"), BagWriter(out) as writer:
+        writer.write_sample(samples[0])
+        assert partial.is_dir() and not (partial / "junk.mcap").exists() and not out.exists()
+        raise RuntimeError("stop")
+    assert not out.exists() and not partial.exists()
+    assert write_bag(samples, out) == 3 and out.is_dir() and not partial.exists()
+    with pytest.raises(FileExistsError, match=f"{out} exists; choose another bag directory"):
+        BagWriter(out)
 
 
 def _write_edited(samples, out: Path, edit) -> None:
@@ -166,6 +217,45 @@ def test_diagnosis_levels_follow_the_alarm(tmp_path):
             writer.write_diagnosis(d, list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES))
     got = _diagnoses(tmp_path / "levels")
     assert [(g[1], g[2]) for g in got] == [(level, message) for _, level, message in cases]
+
+
+def test_a_diagnosis_message_carries_every_field_as_key_values(tmp_path):
+    from rosbags.rosbag2 import Reader
+
+    classes, joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
+    probs = dict(zip(classes, [0.01, 0.02, 0.03, 0.9, 0.02, 0.01, 0.01], strict=True))
+    scores = dict(zip(joints, [0.1, 0.2, 0.8, 0.3, 0.2, 0.1], strict=True))
+    alarmed = HealthDiagnosis(
+        stamp=12.5, stream_id="arm7", sample_index=250, valid=True, fault_present=True,
+        fault_class="jam", class_probabilities=probs, joint_scores=scores,
+        localised_joint="elbow", confidence=0.9, model_id="m-1", alarm="held",
+        alarm_class="jam", alarm_joint="elbow",
+    )  # fmt: skip
+    invalid = HealthDiagnosis(stamp=12.55, stream_id="arm7", sample_index=None, valid=False,
+                              model_id="m-1", reason="x: NaN")  # fmt: skip
+    with BagWriter(tmp_path / "kv") as writer:
+        writer.write_diagnosis(alarmed, classes, joints)
+        writer.write_diagnosis(invalid, classes, joints)
+    store = typestore()
+    with Reader(tmp_path / "kv") as reader:
+        messages = [(stamp, store.deserialize_cdr(raw, conn.msgtype))
+                    for conn, stamp, raw in reader.messages()]  # fmt: skip
+    assert [stamp for stamp, _ in messages] == [stamp_ns(12.5), stamp_ns(12.55)]
+    first, second = (m.status[0] for _, m in messages)
+    assert (first.name, first.hardware_id) == ("health_diagnosis", "m-1")
+    assert {kv.key: kv.value for kv in first.values} == {
+        "fault_class": "jam", "joint": "elbow", "confidence": "0.9000", "alarm": "held",
+        "alarm_class": "jam", "alarm_joint": "elbow", "valid": "true", "sample_index": "250",
+        "p.none": "0.0100", "p.backlash": "0.0200", "p.friction": "0.0300", "p.jam": "0.9000",
+        "p.struct_weaken": "0.0200", "p.sensor_drift": "0.0100", "p.sensor_noise": "0.0100",
+        "score.shoulder_pan": "0.1000", "score.shoulder_lift": "0.2000", "score.elbow": "0.8000",
+        "score.wrist_1": "0.3000", "score.wrist_2": "0.2000", "score.wrist_3": "0.1000",
+    }  # fmt: skip
+    values = {kv.key: kv.value for kv in second.values}
+    assert values["valid"] == "false" and values["sample_index"] == ""
+    assert values["fault_class"] == values["joint"] == ""
+    assert values["alarm_class"] == values["alarm_joint"] == "" and values["alarm"] == "none"
+    assert values["p.jam"] == "0.0000" and values["score.elbow"] == "0.0000"
 
 
 @pytest.fixture(scope="module")

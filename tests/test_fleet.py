@@ -96,12 +96,15 @@ def test_each_bad_row_is_flagged_with_its_reason_and_the_rest_decided(deployed):
     assert list(r.status) == [INVALID] * 5 + [DECIDED]
     where = f"x[{schema.NODE_NAMES[8]}].{schema.FEATURE_NAMES[5]}"
     assert where in r.reasons[0] and "NaN or Inf" in r.reasons[0]
-    assert "node-type indicators" in r.reasons[1]
-    assert "joint nodes must zero the sensor channels" in r.reasons[2]
+    indicators = "node-type indicators do not match the node order"
+    assert r.reasons[1] == f"field 'x.is_joint/is_sensor': {indicators}"
+    assert r.reasons[2] == "field 'x': joint nodes must zero the sensor channels"
     assert "time went backwards" in r.reasons[3]
     assert "gap in sample_index" in r.reasons[4] and "window restarted" in r.reasons[4]
     r = fleet.step(slots[:1], [t + 1], [0.05 * (t + 2)], x[5:6], np.array([False]))
     assert "node order differs" in r.reasons[0]
+    r = fleet.step(slots[5:6], [t + 1], [np.nan], x[5:6])
+    assert r.status[0] == INVALID and r.reasons[0] == "field 't': not finite"
     r = fleet.step(np.array([99]), [0], [0.05], x[5:6])
     assert r.status[0] == INVALID and "unknown stream" in r.reasons[0]
     r = fleet.step(slots[:1], [0], [0.05], np.zeros((1, 3, 3), np.float32))
@@ -189,10 +192,40 @@ def test_alarm_joint_follows_the_smoothed_scores_and_class_switches_reraise():
 
 
 def test_alarm_policy_rejects_nonsense():
-    with pytest.raises(ValueError, match="raise_after"):
-        AlarmPolicy(raise_after=0)
-    with pytest.raises(ValueError, match="min_confidence"):
-        AlarmPolicy(min_confidence=1.5)
+    message = "alarm raise_after and clear_after must be at least 1 tick"
+    for bad in ({"raise_after": 0}, {"clear_after": 0}):
+        with pytest.raises(ValueError) as info:
+            AlarmPolicy(**bad)
+        assert str(info.value) == message
+    for name in ("min_confidence", "clear_confidence", "joint_smoothing"):
+        for bad in (-0.01, 1.5):
+            with pytest.raises(ValueError, match=f"alarm {name} must lie in \\[0, 1\\], got {bad}"):
+                AlarmPolicy(**{name: bad})
+    # the edges are settings a user may choose: one tick, certainty, anything
+    AlarmPolicy(raise_after=1, clear_after=1, min_confidence=1.0, clear_confidence=0.0,
+                joint_smoothing=1.0)  # fmt: skip
+    AlarmPolicy(min_confidence=0.0, clear_confidence=1.0, joint_smoothing=0.0)
+
+
+def test_a_tick_exactly_at_the_threshold_votes():
+    """``min_confidence`` and ``clear_confidence`` are inclusive ("at least")."""
+    policy = AlarmPolicy(raise_after=2, clear_after=2, min_confidence=0.75, clear_confidence=0.5)
+    bank = AlarmBank(policy, 6, 1)
+    states = _run(bank, [(3, 0.75, 2)] * 2 + [(0, 0.5, 0)] * 2)  # exact in float32
+    assert [s for s, _, _ in states] == [NONE, RAISED, HELD, CLEARED]
+
+
+def test_softmax_is_stable_for_large_and_far_apart_logits():
+    from robohealth_mj.runtime.fleet import _softmax
+
+    z = np.array([[120.0, 100.0, 0.0], [0.0, -1.0, -2.0]], np.float32)
+    p = _softmax(z)
+    assert np.isfinite(p).all()
+    np.testing.assert_allclose(p.sum(axis=1), 1.0, rtol=1e-6)
+    e = np.exp(np.array([0.0, -20.0, -120.0]))
+    np.testing.assert_allclose(p[0], e / e.sum(), rtol=1e-5, atol=1e-30)  # float32 underflow
+    e = np.exp(np.array([0.0, -1.0, -2.0]))
+    np.testing.assert_allclose(p[1], e / e.sum(), rtol=1e-5)
 
 
 def _diag(alarm: str = "none", cls: str | None = None, joint: str | None = None):
@@ -261,7 +294,16 @@ def test_sharded_steps_decide_as_one_shard_does(deployed):
     a, b = _replay(one, rec.x, 130, 12), _replay(two, rec.x, 130, 12)
     assert (~np.isnan(a)).sum() == 5 * 130 * 7  # every stream decided on the last 5 ticks
     np.testing.assert_allclose(a, b, atol=1e-6)
-    two.close()
+    two.close()  # the threads stop; later steps run on the calling thread
+    assert two._pool is None and two.shards == 1
+    r = two.step(two.register([f"s{k}" for k in range(130)]), np.full(130, 12),
+                 np.full(130, 0.65), rec.x[12:142])  # fmt: skip
+    assert (r.status == DECIDED).all()
+    assert two.describe() == {
+        "model_id": one.model_id, "window": 8, "mode": "incremental", "threads": 1,
+        "problem": None,
+    }  # fmt: skip
+    assert one.model_id.startswith("stgnn_fixed-structural-w8-")
 
 
 def test_idle_streams_are_released_and_their_slots_reused(deployed):
@@ -356,3 +398,61 @@ def test_choose_prefers_the_fastest_policy_that_meets_every_target():
     assert [meets_targets(r) for r in rows] == [True, True, False, False, False]
     assert choose(rows)["name"] == "fast"
     assert choose(rows[2:])["name"] == "blind"  # none meets them: fewest false alarms
+
+
+def test_growing_the_fleet_keeps_every_stream_s_window_and_alarm(deployed, deciding_alarm):
+    """Streams joining past the allocated capacity grow the state arrays mid-run: the streams
+    already there must decide and alarm exactly as in a fleet that never grew."""
+    rec = load_recordings([deployed["heldout"]])
+    steady = FleetRuntime(deployed["structural_onnx"], alarm=deciding_alarm, capacity=64)
+    growing = FleetRuntime(deployed["structural_onnx"], alarm=deciding_alarm, capacity=1)
+    a, b = steady.register(["a"]), growing.register(["a"])
+    results = {"steady": [], "growing": []}
+    for t in range(400):
+        if t in (120, 190):  # an alarm is up on 'a' at both (the held-out replay's two jams)
+            joined = growing.register([f"n{t}_{k}" for k in range(3 * (t // 60))])
+            assert (joined >= 0).all()
+        for name, fleet, slot in (("steady", steady, a), ("growing", growing, b)):
+            r = fleet.step(slot, [t], [0.05 * (t + 1)], rec.x[t : t + 1])
+            results[name].append((r.status[0], r.alarm[0], r.alarm_class[0], r.alarm_joint[0],
+                                  *r.probs[0].round(6)))  # fmt: skip
+    assert growing.capacity == 16 and steady.capacity == 64  # 1 -> 2 -> 4, then -> 16
+    assert results["steady"] == results["growing"]
+    held = [row for row in results["steady"][120:131] + results["steady"][190:201] if row[2] > 0]
+    assert len(held) >= 15  # the growth happened while alarms were up
+
+
+def test_the_alarm_joint_is_an_ema_over_the_ticks_that_vote_for_its_class():
+    """A script worked by hand: v(j) scores 0.9 at joint j and 0.1 elsewhere; weight 0.3."""
+    policy = AlarmPolicy(raise_after=2, clear_after=3, min_confidence=0.8, joint_smoothing=0.3)
+    bank = AlarmBank(policy, 6, 1)
+    jam, friction, backlash, healthy, unsure = 3, 2, 1, (0, 0.9, 0), 0.5
+    script = [
+        (jam, 0.95, 4),  # a new run: the EMA starts at v(4)
+        (jam, 0.95, 1),  # raised; EMA .7 v(4) + .3 v(1): joint 4 (.66 against .34)
+        (jam, 0.95, 1),  # .492 against .508: joint 1
+        (friction, 0.95, 0),  # another class's vote: ignored
+        (jam, unsure, 0),  # an abstention: ignored
+        (friction, 0.95, 0),  # a new run of friction (the abstention broke the last one)
+        (friction, 0.95, 0),  # re-raised as friction: the EMA restarts at v(0)
+        healthy, healthy, healthy,  # cleared on the third
+        (jam, 0.95, 5),  # a new run: EMA v(5)
+        (jam, 0.95, 2),  # raised: joint 5 (.66 against .34)
+        healthy, healthy, healthy,
+        (backlash, 0.95, 3), (backlash, 0.95, 3),  # raised: joint 3 (EMA v(3))
+        (backlash, 0.95, 0),  # .66 against .34: joint 3
+        (jam, 0.95, 5),  # another class while backlash is up: ignored
+        (jam, unsure, 5),
+        (jam, 0.95, 5),  # ignored again (one vote, no re-raise)
+        (backlash, 0.95, 0),  # .492 against .508: joint 0
+    ]  # fmt: skip
+    got = _run(bank, script)
+    expected = [
+        (NONE, 0, -1), (RAISED, jam, 4), (HELD, jam, 1), (HELD, jam, 1), (HELD, jam, 1),
+        (HELD, jam, 1), (RAISED, friction, 0), (HELD, friction, 0), (HELD, friction, 0),
+        (CLEARED, 0, -1), (NONE, 0, -1), (RAISED, jam, 5), (HELD, jam, 5), (HELD, jam, 5),
+        (CLEARED, 0, -1), (NONE, 0, -1), (RAISED, backlash, 3), (HELD, backlash, 3),
+        (HELD, backlash, 3), (HELD, backlash, 3), (HELD, backlash, 3), (HELD, backlash, 0),
+    ]  # fmt: skip
+    assert got == expected
+    np.testing.assert_allclose(bank.scores[0, [0, 3]], [0.508, 0.492], atol=1e-6)

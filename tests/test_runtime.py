@@ -19,8 +19,9 @@ from robohealth_mj.runtime.alarms import CLEARED, HELD, RAISED
 from robohealth_mj.runtime.export import RawInput, export_checkpoint, read_metadata
 from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
-from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
-from robohealth_mj.schema import FaultLabel
+from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime, decide
+from robohealth_mj.runtime.runtime import diagnoses as tick_diagnoses
+from robohealth_mj.schema import FaultLabel, GraphSample
 
 F = schema.N_FEATURES
 
@@ -89,10 +90,15 @@ def test_export_fails_loudly_without_held_out_data(deployed, tmp_path):
 
 def test_runtime_on_a_replay_decides_as_batch_evaluation_does(deployed):
     runtime = ModelRuntime(deployed["structural_onnx"])
+    assert runtime.describe()["mode"] == "incremental" and runtime.describe()["threads"] == 1
     lines = deployed["heldout"].read_text().splitlines()
     diagnoses = [runtime.process("arm", line) for line in lines]
     assert all(d.valid for d in diagnoses)
     assert all(d.fault_class is None for d in diagnoses[:7])  # warming up
+    assert [d.sample_index for d in diagnoses] == [json.loads(x)["sample_index"] for x in lines]
+    assert {d.model_id for d in diagnoses} == {runtime.model_id} != {"none"}
+    assert {d.stream_id for d in diagnoses} == {"arm"}
+    assert all(d.inference_latency_ms > 0 for d in diagnoses[7:])
     ckpt = load_checkpoint(deployed["structural_ckpt"])
     model = model_from_checkpoint(ckpt)
     rec = load_recordings([deployed["heldout"]])
@@ -162,6 +168,27 @@ def test_alarms_raise_hold_and_clear_through_the_fleet_runtime(deployed, decidin
         np.testing.assert_array_equal(together[:, k], alone[: len(together), 0])
 
 
+def test_a_row_of_an_unknown_slot_is_diagnosed_as_stream_question_mark(deployed):
+    runtime = ModelRuntime(deployed["structural_onnx"], threads=2, incremental=False)
+    assert runtime.describe()["mode"] == "windowed" and runtime.describe()["threads"] == 2
+    fleet = runtime.fleet
+    x = load_recordings([deployed["heldout"]]).x[:1]
+    (d,) = tick_diagnoses(fleet, fleet.step(np.array([fleet.capacity]), [0], [0.05], x))
+    assert (d.stream_id, d.valid, d.sample_index) == ("?", False, 0)
+    assert "unknown stream" in d.reason and d.model_id == fleet.model_id
+
+
+def test_a_decision_refuses_outputs_that_do_not_match_the_labels():
+    """A model whose outputs and metadata disagree in length must fail loudly, not label
+    probabilities with the wrong names."""
+    classes, joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
+    d = HealthDiagnosis(stamp=0.0, stream_id="s", sample_index=0, valid=True)
+    with pytest.raises(ValueError):
+        decide(d, np.full(6, 1 / 6), np.zeros(6), 0, 0, -1, classes, joints)
+    with pytest.raises(ValueError):
+        decide(d, np.full(7, 1 / 7), np.zeros(5), 0, 0, -1, classes, joints)
+
+
 def _line(deployed, k: int = 0) -> dict:
     return json.loads(deployed["heldout"].read_text().splitlines()[k])
 
@@ -185,7 +212,20 @@ def test_each_invalid_sample_yields_a_flagged_diagnosis(deployed, corrupt, reaso
     corrupt(bad)
     d = runtime.process("arm", bad)
     assert not d.valid and reason in d.reason
-    assert runtime.process("arm", "{not json").valid is False
+
+
+def test_a_sample_that_does_not_parse_is_flagged_at_once_naming_the_field(deployed):
+    runtime = ModelRuntime(deployed["structural_onnx"])
+    d = runtime.process("arm", "{not json")
+    assert (d.valid, d.stream_id, d.stamp, d.sample_index) == (False, "arm", 0.0, None)
+    assert d.model_id == runtime.model_id != "none"
+    assert d.reason.startswith("<sample>: field '<json>': invalid JSON (")
+    bad = GraphSample("r", 0, 0.05, np.zeros((3, 3), np.float32), FaultLabel(), {})
+    assert runtime.process("arm", bad).reason == "<sample>: field 'x': shape (3, 3)"
+    line = _line(deployed)
+    del line["t"]
+    assert runtime.process("arm", line).reason.startswith("stream: field 't': ")
+    assert runtime.streams == ["arm"]  # flagged samples still name their stream
 
 
 @pytest.mark.parametrize("model", [None, "missing.onnx", "broken"])
@@ -329,3 +369,14 @@ def test_monitor_diagnoses_the_simulator_live(deployed, deciding_alarm, tmp_path
     assert result["alarms"]["class_latency_s_median"] <= 2.0
     printed = capsys.readouterr().out
     assert "ALARM RAISED backlash @ elbow" in printed and "[truth: backlash @ elbow" in printed
+
+
+def test_a_diagnosis_serialises_to_sorted_json_that_rebuilds_it():
+    d = HealthDiagnosis(stamp=1.5, stream_id="arm", sample_index=30, valid=True,
+                        fault_present=True, fault_class="jam", confidence=0.9,
+                        class_probabilities={"none": 0.1, "jam": 0.9}, alarm="raised",
+                        alarm_class="jam", alarm_joint="elbow")  # fmt: skip
+    text = d.to_json()
+    assert HealthDiagnosis(**json.loads(text)) == d
+    keys = list(json.loads(text))
+    assert keys == sorted(keys) and text.startswith('{"alarm": "raised", "alarm_class": "jam"')

@@ -98,7 +98,7 @@ class FleetRuntime:
     ) -> None:
         self.max_streams, self.max_burst = max_streams, max_burst
         self.max_gap_s, self.idle_ticks = max_gap_s, idle_ticks
-        self.shards = max(1, shards)
+        self.shards, self.threads = max(1, shards), threads
         capacity = max(1, min(capacity, max_streams))
         self._pool = ThreadPoolExecutor(self.shards) if self.shards > 1 else None
         self.window, self.model_id, self.problem = 16, "none", None
@@ -367,7 +367,7 @@ class FleetRuntime:
             self.release(np.flatnonzero(idle))
 
     def close(self) -> None:
-        """Stop the shard threads (the runtime cannot step afterwards)."""
+        """Stop the shard threads; later steps run on the calling thread."""
         if self._pool is not None:
             self._pool.shutdown()
             self._pool = None
@@ -378,6 +378,7 @@ class FleetRuntime:
             "model_id": self.model_id,
             "window": self.window,
             "mode": self.mode,
+            "threads": self.threads,
             "problem": self.problem,
         }
 
