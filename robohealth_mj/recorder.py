@@ -106,21 +106,36 @@ class SessionStats:
         }
 
 
+@dataclass
+class _StopRequest:
+    """The signal that asked the recording to stop, if any (see :func:`_stop_between_chunks`)."""
+
+    signum: int | None = None
+
+    def check(self) -> None:
+        if self.signum is not None:
+            raise KeyboardInterrupt(f"signal {self.signum}")
+
+
 @contextmanager
-def _sigterm_as_interrupt():
-    """Turn SIGTERM into KeyboardInterrupt so a killed job still closes its manifest."""
+def _stop_between_chunks():
+    """Ctrl-C and SIGTERM (a killed job) stop the recording at the next chunk boundary, so the
+    lines on disk and the manifest's sample count always agree; an exception raised by the
+    signal itself could land between writing a chunk and counting it."""
+    request = _StopRequest()
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield request  # signals reach the main thread only
         return
 
     def handler(signum: int, frame: Any) -> None:
-        raise KeyboardInterrupt(f"signal {signum}")
+        request.signum = signum
 
-    previous = signal.signal(signal.SIGTERM, handler)
+    previous = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        yield
+        yield request
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for s, h in previous.items():
+            signal.signal(s, h)
 
 
 def build_simulator(cfg: DictConfig) -> ArmSimulator:
@@ -191,11 +206,15 @@ def record_session(cfg: DictConfig, out_dir: Path | str) -> RecordingResult:
         dynamic_ncols=True,
     )
     try:
-        with _sigterm_as_interrupt(), (out_dir / GRAPHS_FILE).open("w", encoding="utf-8") as out:
+        with (
+            _stop_between_chunks() as stop,
+            (out_dir / GRAPHS_FILE).open("w", encoding="utf-8") as out,
+        ):
             for chunk in sim.run(n_ticks):
                 out.write(_chunk_lines(sim, chunk, run_id, stats))
                 out.flush()
                 progress.update(len(chunk.t))
+                stop.check()
         status, reason = "complete", None
     except KeyboardInterrupt:
         reason = "interrupted"

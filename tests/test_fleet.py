@@ -121,7 +121,8 @@ def test_a_burst_is_taken_in_order_up_to_the_limit(deployed):
     n = one.window + 7
     burst = one.step(np.repeat(s1, n), np.arange(n), 0.05 * (np.arange(n) + 1), rec.x[:n])
     assert list(burst.status[:5]) == [WARMING] * 5
-    assert all("burst" in burst.reasons[k] for k in range(5, n))
+    dropped = "burst: more than 5 samples from this stream in one tick; dropped"
+    assert all(burst.reasons[k] == dropped for k in range(5, n))
     singles = [each.step(s2, [k], [0.05 * (k + 1)], rec.x[k : k + 1]) for k in range(5)]
     assert [s.status[0] for s in singles] == list(burst.status[:5])
     # the next sample after the dropped ones is a gap
@@ -456,3 +457,50 @@ def test_the_alarm_joint_is_an_ema_over_the_ticks_that_vote_for_its_class():
     ]  # fmt: skip
     assert got == expected
     np.testing.assert_allclose(bank.scores[0, [0, 3]], [0.508, 0.492], atol=1e-6)
+
+
+def _with_metadata(src, out, **changes: str):
+    import onnx
+
+    proto = onnx.load(str(src))
+    for prop in proto.metadata_props:
+        if prop.key in changes:
+            prop.value = changes[prop.key]
+    onnx.save(proto, str(out))
+    return out
+
+
+def test_a_model_of_another_node_order_or_schema_is_refused_with_the_reason(deployed, tmp_path):
+    import json
+
+    onnx_path = deployed["structural_onnx"]
+    reordered = json.dumps(list(schema.NODE_NAMES[::-1]))
+    fleet = FleetRuntime(_with_metadata(onnx_path, tmp_path / "order.onnx", node_names=reordered))
+    assert fleet.engine is None and fleet.problem.endswith(
+        "ValueError: model node order differs from this schema"
+    )
+    fleet = FleetRuntime(_with_metadata(onnx_path, tmp_path / "old.onnx", schema_version="1.0"))
+    assert fleet.engine is None and fleet.problem.endswith("model schema 1.0 != 2.0")
+
+
+def test_the_default_fleet_takes_8192_streams():
+    fleet = FleetRuntime(None)
+    slots = fleet.register([f"arm{k}" for k in range(8193)])
+    assert (slots[:8192] >= 0).all() and slots[8192] == -1 and len(set(slots[:8192])) == 8192
+
+
+def test_stamps_and_indices_must_move_forward_and_hold_no_gap(deployed):
+    rec = load_recordings([deployed["heldout"]])
+    fleet = FleetRuntime(deployed["structural_onnx"])
+    slots = fleet.register(["a", "b"])
+    fleet.step(slots, [0, 0], [0.05, 0.05], rec.x[:2])
+    # 'a' re-sends index 0 with a later stamp; 'b' jumps from its first index 0 to 5
+    r = fleet.step(slots, [0, 5], [0.1, 0.3], rec.x[1:3])
+    assert r.status[0] == INVALID and r.reasons[0].startswith("time went backwards: t=0.1 ")
+    assert r.reasons[1] == ("gap in sample_index (0 -> 5) or over 0.25 s of time; window restarted")
+    # layout flags may be any booleans, 0/1 included
+    r = fleet.step(slots, [1, 6], [0.15, 0.35], rec.x[2:4], np.array([1, 1], np.int8))
+    assert list(r.status) == [WARMING, WARMING]
+    # a tick of the wrong shape keeps its rows' stamps and indices
+    r = fleet.step(slots, [2, 7], [0.2, 0.4], np.zeros((2, 3, 3), np.float32))
+    assert list(r.t) == [0.2, 0.4] and list(r.sample_index) == [2, 7]

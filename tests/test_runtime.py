@@ -236,7 +236,10 @@ def test_without_a_usable_model_the_runtime_says_so_and_never_echoes_labels(
         (tmp_path / "broken.onnx").write_bytes(b"not an onnx model")
         model = tmp_path / "broken.onnx"
     runtime = ModelRuntime(model)
-    assert "without a model" in caplog.text
+    assert (
+        f"runtime running without a model ({runtime.problem}): every diagnosis will say 'no "
+        "model', fault absent, confidence 0"
+    ) in caplog.text
     lines = deployed["heldout"].read_text().splitlines()
     faulted = [k for k, line in enumerate(lines) if json.loads(line)["fault"]["active"]]
     assert faulted
