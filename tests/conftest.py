@@ -73,6 +73,13 @@ def deciding_alarm() -> AlarmPolicy:
     return DECIDING_ALARM
 
 
+@pytest.fixture(scope="session")
+def deciding_alarm_args() -> list[str]:
+    """:data:`DECIDING_ALARM` as the monitor's ``alarm.*=`` overrides."""
+    return [f"alarm.{k}={getattr(DECIDING_ALARM, k)}"
+            for k in ("raise_after", "clear_after", "min_confidence")]  # fmt: skip
+
+
 def cached(tmp_path_factory, name: str, build: Callable[[Path], dict]) -> dict:
     """``build(root)`` once per session, or once per ``ROBOHEALTH_TEST_CACHE`` directory: its
     JSON-able result is kept beside what it wrote, and a later session reuses both."""

@@ -259,15 +259,13 @@ def test_a_diagnosis_message_carries_every_field_as_key_values(tmp_path):
 
 
 @pytest.fixture(scope="module")
-def diagnosed(deployed, deciding_alarm, bag, tmp_path_factory) -> dict[str, Path]:
+def diagnosed(deployed, deciding_alarm_args, bag, tmp_path_factory) -> dict[str, Path]:
     """The monitor's replays of the held-out JSONL and of its bag, each written to a bag."""
     root = tmp_path_factory.mktemp("diagnosed")
-    alarm = [f"alarm.{k}={getattr(deciding_alarm, k)}" for k in ("raise_after", "clear_after",
-             "min_confidence")]  # fmt: skip
     out = {"jsonl": root / "from_jsonl", "bag": root / "from_bag"}
     for source, target in ((deployed["heldout"], out["jsonl"]), (bag, out["bag"])):
         monitor_main([f"model={deployed['structural_onnx']}", "source=replay", f"file={source}",
-                      "quiet=true", f"bag_out={target}", *alarm])  # fmt: skip
+                      "quiet=true", f"bag_out={target}", *deciding_alarm_args])  # fmt: skip
     return out
 
 

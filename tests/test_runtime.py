@@ -316,13 +316,8 @@ def test_online_evaluation_measures_detection_latency_on_a_scripted_stream():
     assert r["online_accuracy"] == pytest.approx((4 + 2 + 3 + 2) / decided)
 
 
-def _alarm_args(policy) -> list[str]:
-    return [f"alarm.{k}={getattr(policy, k)}" for k in ("raise_after", "clear_after",
-            "min_confidence")]  # fmt: skip
-
-
 def test_monitor_replays_and_evaluates_with_its_alarm_settings(
-    deployed, deciding_alarm, tmp_path, capsys
+    deployed, deciding_alarm, deciding_alarm_args, tmp_path, capsys
 ):
     out = tmp_path / "online.json"
     result = monitor_main(
@@ -331,7 +326,7 @@ def test_monitor_replays_and_evaluates_with_its_alarm_settings(
             "source=replay",
             f"file={deployed['heldout']}",
             "evaluate=true",
-            *_alarm_args(deciding_alarm),
+            *deciding_alarm_args,
             f"out={out}",
         ]
     )
@@ -352,7 +347,7 @@ def test_monitor_replays_and_evaluates_with_its_alarm_settings(
         assert swept[key] == result[key], key
 
 
-def test_monitor_diagnoses_the_simulator_live(deployed, deciding_alarm, tmp_path, capsys):
+def test_monitor_diagnoses_the_simulator_live(deployed, deciding_alarm_args, tmp_path, capsys):
     """``source=sim``: the simulator's samples straight into the runtime, here with a backlash
     at the elbow held on from the start (a fault the deployed model was trained on)."""
     fault = "faults=fixed,faults.schedule.fault_class=backlash,faults.schedule.joint=elbow"
@@ -363,7 +358,7 @@ def test_monitor_diagnoses_the_simulator_live(deployed, deciding_alarm, tmp_path
             "duration_s=6",
             f"sim_overrides=[seed=5,{fault},faults.schedule.severity=0.9]",
             "evaluate=true",
-            *_alarm_args(deciding_alarm),
+            *deciding_alarm_args,
             f"out={tmp_path / 'sim.json'}",
         ]
     )
