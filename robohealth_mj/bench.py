@@ -63,6 +63,18 @@ def main(argv: list[str] | None = None) -> None:
         p.add_argument("--seconds", type=float, default=seconds, help="paced run length")
         p.add_argument("--shards", type=int, default=2, help="threads the fleet step uses")
     streams.add_argument("--no-search", action="store_true", help="skip the stream-count search")
+    streams.add_argument(
+        "--memory-horizon",
+        type=float,
+        default=10.0,
+        help="evidence horizon (s) of the with/without-memory comparison",
+    )
+    streams.add_argument(
+        "--memory-rounds",
+        type=int,
+        default=3,
+        help="alternated rounds of the with/without-memory comparison",
+    )
     args = parser.parse_args(argv)
     if args.what in ("streams", "soak"):
         from robohealth_mj.benchmarks.fleet import bench_fleet, bench_soak

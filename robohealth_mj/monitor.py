@@ -21,6 +21,7 @@ from contextlib import ExitStack
 from datetime import datetime
 from pathlib import Path
 
+import numpy as np
 from omegaconf import DictConfig
 
 from robohealth_mj.atomic import atomic_write_json, atomic_write_text
@@ -31,11 +32,19 @@ from robohealth_mj.config import compose_config, load_cli_config
 from robohealth_mj.errors import InputError, one_line_errors
 from robohealth_mj.reporting.online import online_markdown
 from robohealth_mj.runtime.alarms import AlarmPolicy
+from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.export import read_metadata
 from robohealth_mj.runtime.fleet import freeze_startup_heap
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
-from robohealth_mj.schema import FaultLabel, GraphSample, SchemaError, validate_sample
+from robohealth_mj.schema import (
+    JOINT_NAMES,
+    FaultLabel,
+    GraphSample,
+    SchemaError,
+    feature_index,
+    validate_sample,
+)
 
 
 def sim_stream(
@@ -88,20 +97,31 @@ def main(argv: list[str] | None = None) -> dict | None:
 
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     cfg = load_config(sys.argv[1:] if argv is None else argv)
-    try:
-        policy = AlarmPolicy(**cfg.alarm)
-    except (TypeError, ValueError) as exc:
-        raise SystemExit(f"conf/monitor.yaml alarm: {exc}") from None
+    policy = _policy("alarm", AlarmPolicy, cfg)
+    evidence = _policy("evidence", EvidencePolicy, cfg)
     with one_line_errors("monitor"):
-        return _monitor(cfg, policy)
+        return _monitor(cfg, policy, evidence)
 
 
-def _monitor(cfg: DictConfig, policy: AlarmPolicy) -> dict | None:
+def _policy(key: str, kind: type, cfg: DictConfig):
+    """The ``alarm`` or ``evidence`` block as its policy; a bad value is the user's to fix."""
+    with one_line_errors("monitor"):
+        try:
+            return kind(**cfg[key])
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"conf/monitor.yaml {key}: {exc}") from None
+
+
+def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> dict | None:
+    """Run the source through the runtime; with ``evaluate``, the on-line figures. Healthy ticks
+    count as settled once the window, the evidence and the alarm have had time to let a fault
+    go (``settle``)."""
     if cfg.model:
         read_metadata(cfg.model)  # a model named but unusable is the user's to fix
     runtime = ModelRuntime(
-        cfg.model, threads=cfg.threads, alarm=policy, incremental=cfg.incremental
-    )
+        cfg.model, threads=cfg.threads, alarm=policy, incremental=cfg.incremental,
+        evidence=evidence,
+    )  # fmt: skip
     if cfg.source == "sim":
         stream = sim_stream(list(cfg.sim_overrides), cfg.duration_s)
     elif cfg.source == "replay":
@@ -114,7 +134,7 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy) -> dict | None:
     else:
         raise InputError(f"source must be sim or replay, got {cfg.source!r}")
     freeze_startup_heap()
-    settle = runtime.window + policy.clear_after
+    settle = runtime.window + policy.clear_after + evidence.clearing_ticks
     evaluator = OnlineEvaluator(settle_ticks=settle) if cfg.evaluate else None
     last, started, t0 = None, time.perf_counter(), None
     with ExitStack() as stack:
@@ -130,7 +150,7 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy) -> dict | None:
                 bag.write_sample(sample)
                 bag.write_diagnosis(d, runtime.fleet.classes, runtime.fleet.joints)
             if evaluator is not None and truth is not None:
-                evaluator.update(truth, d)
+                evaluator.update(truth, d, *_joint_activity(sample))
             if not cfg.quiet:
                 last = _print(cfg.stream_id, t, d, truth, last)
     if cfg.bag_out:
@@ -142,6 +162,7 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy) -> dict | None:
         "source": cfg.source,
         "file": cfg.file,
         "alarm_policy": dict(cfg.alarm),
+        "evidence_policy": dict(cfg.evidence),
         **evaluator.result(),
     }
     stamp = datetime.now().strftime("%Y-%m-%d_%H-%M-%S")
@@ -159,6 +180,15 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy) -> dict | None:
         f"{_num(alarms['joint_latency_s_median'])} s (medians) -> {out}"
     )
     return result
+
+
+def _joint_activity(sample) -> tuple:
+    """The joints' speeds and torques ``[J]`` of a sample (for the evaluator's physically
+    hidden strata), or nothing for a line that did not parse."""
+    if not isinstance(sample, GraphSample):
+        return ()
+    joints = sample.x[: len(JOINT_NAMES)]
+    return np.abs(joints[:, feature_index("vel")]), joints[:, feature_index("effort")]
 
 
 def _print(stream_id: str, t: float, d: HealthDiagnosis, truth, last: str | None) -> str | None:

@@ -5,8 +5,10 @@ The model's decisions are computed once (``--healthy``: also on a healthy-only s
 false alarms per hour rest on hours, not minutes), then every policy of the grid replays over
 them; the
 table (markdown) lists each policy's detection rate, false alarms and latency, and the last line
-names the policy that meets the targets with the lowest median latency to class. Put it in
-``conf/monitor.yaml``'s ``alarm`` block.
+names the chosen policy (see :func:`~robohealth_mj.runtime.alarm_sweep.choose`). Put it in
+``conf/monitor.yaml``'s ``evidence`` and ``alarm`` blocks. The grid covers memory (``evidence``:
+how window probabilities accumulate) and the alarm's debouncing together, since each changes
+what the other should be.
 """
 
 from __future__ import annotations
@@ -19,6 +21,11 @@ from robohealth_mj.runtime.alarm_sweep import choose, meets_targets, replay_deci
 
 def _f(value: float | None) -> str:
     return "–" if value is None else f"{value:.3g}"
+
+
+def _moot(row: dict, key: str) -> str:
+    """An evidence setting, or '–' where it does nothing (no memory)."""
+    return f"{row[key]:g}" if row["horizon_s"] > 0 else "–"
 
 
 def main(argv: list[str] | None = None) -> dict:
@@ -39,21 +46,33 @@ def main(argv: list[str] | None = None) -> dict:
         + f"; {rows[0]['healthy_hours']:.2f} h of settled healthy running\n"
     )
     print(
-        "| raise_after | clear_after | min_confidence | detected | false alarm ticks | "
-        "false alarms / h | to class s | to joint s | meets targets |\n"
-        "|---|---|---|---|---|---|---|---|---|"
+        "| horizon_s | clip | floor | raise_after | clear_after | min_confidence | detected | "
+        "observable detected | right at rise | false alarm ticks | false alarms / h | "
+        "to class s | to joint s | meets targets |\n|---|---|---|---|---|---|---|---|---|---|---|"
+        "---|---|---|"
     )
     for r in rows:
         print(
-            f"| {r['raise_after']} | {r['clear_after']} | {r['min_confidence']} | "
-            f"{_f(r['detection_rate'])} | {_f(r['false_alarm_rate'])} | "
+            f"| {r['horizon_s']:g} | {_moot(r, 'clip')} | {_moot(r, 'floor')} | "
+            f"{r['raise_after']} | "
+            f"{r['clear_after']} | {r['min_confidence']} | {_f(r['detection_rate'])} | "
+            f"{_f(r['observable_detection_rate'])} | "
+            f"{_f(r['right_at_rise_rate'])} | {_f(r['false_alarm_rate'])} | "
             f"{_f(r['false_alarms_per_hour'])} | {_f(r['class_latency_s_median'])} | "
             f"{_f(r['joint_latency_s_median'])} | {'yes' if meets_targets(r) else ''} |"
         )
     best = choose(rows)
+    memory = (
+        f" evidence.clip={best['clip']:g} evidence.floor={best['floor']:g}"
+        if best["horizon_s"] > 0
+        else ""
+    )
     print(
-        f"\nchosen: raise_after={best['raise_after']} clear_after={best['clear_after']} "
-        f"min_confidence={best['min_confidence']} (selection data: {args.data})"
+        f"\nchosen: evidence.horizon_s={best['horizon_s']:g}{memory} "
+        f"alarm.raise_after={best['raise_after']} "
+        f"alarm.clear_after={best['clear_after']} alarm.min_confidence={best['min_confidence']} "
+        f"({'meets every target' if meets_targets(best) else 'meets no policy every target'}; "
+        f"selection data: {args.data})"
     )
     return best
 

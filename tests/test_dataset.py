@@ -147,6 +147,27 @@ def test_standard_corpus_plan_has_the_thesis_roles():
     assert "curriculum.payload_scales=[2.2]" in probe.overrides
 
 
+def _healthy_segment_starts(overrides: tuple[str, ...]) -> float:
+    """Share of one fault pass's curriculum segment starts that fall in a healthy interval."""
+    from hydra.utils import instantiate
+
+    cfg = compose_config("record", list(overrides))
+    schedule = instantiate(cfg.faults.schedule, tick_s=0.05, seed=0, _convert_="all")
+    segment = round(cfg.curriculum.segment_s / 0.05)
+    starts = range(0, schedule.pass_ticks, segment)
+    return sum(schedule.interval_at(t).scenario is None for t in starts) / len(starts)
+
+
+def test_standard_training_sessions_hold_healthy_segment_starts():
+    """A model must see a segment start (arm at rest, payload taken on) while healthy, or it
+    learns that a segment start is a fault. The held-out replay keeps the default schedule."""
+    specs = plan(compose_config("corpus").corpus, [])
+    train = [s for s in specs if s.role == "train"]
+    heldout = next(s for s in specs if s.role == "heldout")
+    assert all(_healthy_segment_starts(s.overrides) > 0.3 for s in train)
+    assert _healthy_segment_starts(heldout.overrides) == 0.0
+
+
 def test_corpus_records_roles_in_parallel_and_resumes(tmp_path):
     spec = OmegaConf.to_container(compose_config("corpus", ["corpus=quick"]).corpus)
     spec["train"].update(sessions=3, lengths=[{"duration_s": 2}])

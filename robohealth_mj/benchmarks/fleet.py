@@ -5,8 +5,11 @@ from __future__ import annotations
 import argparse
 import os
 
+import numpy as np
+
 from robohealth_mj.benchmarks.soak import soak
 from robohealth_mj.benchmarks.streams import TICK_S, search, trial
+from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import FleetRuntime, freeze_startup_heap
 
 
@@ -47,7 +50,31 @@ def bench_fleet(args: argparse.Namespace) -> dict:
     )
     print(_row(f"incremental, paced 20 Hz for {args.seconds:g} s", paced))
     print(_row("windowed (same runtime, whole window per tick), 40 ticks", windowed))
-    return {"sustained_streams": found, "paced": paced, "windowed": windowed}
+    memory = memory_cost(args, x)
+    return {"sustained_streams": found, "paced": paced, "windowed": windowed, "memory": memory}
+
+
+def memory_cost(args: argparse.Namespace, x) -> dict:
+    """The step with and without evidence accumulation at ``--streams``, unpaced, alternated
+    (off, on, off, on) so that outside load falls on both alike; the ratio of their medians."""
+    policy = EvidencePolicy(horizon_s=args.memory_horizon)
+    runs: dict[str, list[dict]] = {"off": [], "on": []}
+    for _ in range(args.memory_rounds):
+        for key, evidence in (("off", None), ("on", policy)):
+            runs[key].append(trial(args.model, x, args.streams, 200, shards=args.shards,
+                                   evidence=evidence))  # fmt: skip
+    p50 = {k: float(np.median([r["p50_ms"] for r in v])) for k, v in runs.items()}
+    p99 = {k: float(np.median([r["p99_ms"] for r in v])) for k, v in runs.items()}
+    print(
+        f"\nmemory (evidence horizon {policy.horizon_s:g} s) at {args.streams} streams, unpaced, "
+        f"{args.memory_rounds} x 200 ticks each, alternated:\n"
+        f"| evidence | p50 ms | p99 ms |\n|---|---|---|\n"
+        f"| off | {p50['off']:.2f} | {p99['off']:.2f} |\n"
+        f"| on | {p50['on']:.2f} | {p99['on']:.2f} |\n"
+        f"step time with memory / without: p50 {p50['on'] / p50['off']:.3f}, "
+        f"p99 {p99['on'] / p99['off']:.3f}"
+    )
+    return {"p50_ms": p50, "p99_ms": p99, "ratio_p50": p50["on"] / p50["off"]}
 
 
 def bench_soak(args: argparse.Namespace) -> dict:

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime, freeze_startup_heap
 
 TICK_S = 0.05
@@ -84,11 +85,12 @@ def trial(
     threads: int = 1,
     shards: int = 2,
     paced: bool = False,
+    evidence: EvidencePolicy | None = None,
 ) -> dict[str, float]:
     """A fresh runtime with ``streams`` streams: fill the windows, then time ``ticks`` ticks."""
     fleet = FleetRuntime(
         model, threads=threads, shards=shards, incremental=incremental, capacity=streams,
-        max_streams=streams,
+        max_streams=streams, evidence=evidence,
     )  # fmt: skip
     if fleet.engine is None:
         raise ValueError(fleet.problem)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from robohealth_mj.schema import JOINT_NAMES
+
 
 def _f(value: float | None, digits: int = 2) -> str:
     return "–" if value is None else f"{value:.{digits}f}"
@@ -12,9 +14,32 @@ def _f(value: float | None, digits: int = 2) -> str:
 def _row(name: str, a: dict[str, Any]) -> str:
     return (
         f"| {name} | {a['episodes']} | {_f(a['detection_rate'])} | "
+        f"{_f(a.get('right_at_rise_rate'))} | "
         f"{_f(a['class_latency_s_median'])} / {_f(a['class_latency_s_p90'])} | "
         f"{_f(a['joint_latency_s_median'])} / {_f(a['joint_latency_s_p90'])} |"
     )
+
+
+HEADER = [
+    "| episodes of | n | detected | class and joint right at rise | to class s (median / p90) "
+    "| to joint s (median / p90) |",
+    "|---|---|---|---|---|---|",
+]
+
+
+def _detection_grid(by_joint: dict[str, dict[str, Any]]) -> list[str]:
+    """Detected / episodes per class (rows) x joint (columns)."""
+    classes = sorted({k.split("@")[0] for k in by_joint})
+    joints = list(JOINT_NAMES)
+    lines = ["| detected | " + " | ".join(joints) + " |", "|---" * (len(joints) + 1) + "|"]
+    for c in classes:
+        cells = [by_joint.get(f"{c}@{j}") for j in joints]
+        lines.append(
+            f"| {c} | "
+            + " | ".join("–" if a is None else f"{a['detected']}/{a['episodes']}" for a in cells)
+            + " |"
+        )
+    return lines
 
 
 def online_markdown(result: dict[str, Any]) -> str:
@@ -32,12 +57,27 @@ def online_markdown(result: dict[str, Any]) -> str:
         f"- latency to the right class: median {_f(a['class_latency_s_median'])} s, p90 "
         f"{_f(a['class_latency_s_p90'])} s; to the right joint: median "
         f"{_f(a['joint_latency_s_median'])} s, p90 {_f(a['joint_latency_s_p90'])} s",
+        f"- class and joint right when the alarm rose: {a.get('right_at_rise')} of "
+        f"{a['detected']} detected episodes ({_f(a.get('right_at_rise_rate'), 3)})",
         f"- per-tick on-line accuracy {_f(result['online_accuracy'], 3)}",
         "",
-        "| episodes of | n | detected | to class s (median / p90) | to joint s (median / p90) |",
-        "|---|---|---|---|---|",
+        *HEADER,
     ]
     lines += [_row(k, v) for k, v in result["alarms_by_class"].items()]
     lines += [_row(f"severity {k}", v) for k, v in result["alarms_by_severity"].items()]
+    lines += [_row(k, v) for k, v in result.get("alarms_by_visibility", {}).items()]
     lines.append(_row("**all**", a))
+    if result.get("alarms_by_class_and_severity"):
+        lines += ["", "Per class and severity:", "", *HEADER]
+        lines += [_row(k, v) for k, v in result["alarms_by_class_and_severity"].items()]
+    if result.get("alarms_by_class_and_joint"):
+        lines += ["", "Episodes detected per class and joint:", ""]
+        lines += _detection_grid(result["alarms_by_class_and_joint"])
+    hidden = result.get("physically_hidden_episodes")
+    if hidden:
+        lines += [
+            "",
+            f"Physically hidden (friction on a joint that never moved, weakening of a joint that "
+            f"never carried load): {', '.join(hidden)}",
+        ]
     return "\n".join(lines) + "\n"

@@ -27,9 +27,9 @@ STATE_NAMES = ("none", "raised", "held", "cleared")
 class AlarmPolicy:
     """Debouncing (``raise_after``, ``clear_after``, in ticks) and hysteresis thresholds."""
 
-    raise_after: int = 6
+    raise_after: int = 10
     clear_after: int = 10
-    min_confidence: float = 0.97
+    min_confidence: float = 0.9
     clear_confidence: float = 0.5
     joint_smoothing: float = 0.3  # EMA weight of the newest tick's joint scores
 

@@ -222,6 +222,7 @@ def export_checkpoint(
         data_fingerprint=ckpt["data_fingerprint"],
         code_version=ckpt["code_version"],
         parity_error=f"{error:.3g}",
+        joint_scores=joint_score_kind(ckpt),
         **incremental,
     )
     attach_metadata(tmp, out, metadata)  # writes one self-contained file
@@ -232,6 +233,15 @@ def export_checkpoint(
         "windows": len(windows),
         "metadata": metadata,
     }
+
+
+def joint_score_kind(ckpt: dict[str, Any]) -> str:
+    """How the runtime turns joint logits into scores, as the model was trained: ``softmax``
+    over the joints (the default loss: one joint at fault, the joints compete) or ``sigmoid``
+    per joint (the thesis's BCE). Softmax-trained logits are not sigmoid-calibrated: on a
+    confident window every joint's logit is large, and sigmoid scores all saturate at 1."""
+    trainer = (ckpt.get("config") or {}).get("trainer") or {}
+    return "softmax" if trainer.get("joint_softmax", True) else "sigmoid"
 
 
 def model_metadata(

@@ -4,7 +4,9 @@ Samples arrive as arrays, one row per sample: ``slots [R]`` (from :meth:`FleetRu
 ``sample_index [R]``, ``t [R]``, ``x [R, 12, F]`` (and optionally ``layout_ok [R]``, whether the
 sender's node order is the schema's). Every check is vectorised over the rows, each stream's
 window lives in preallocated arrays (:mod:`robohealth_mj.runtime.incremental`), the model runs
-once per tick on every stream whose window is full, and the alarms update in bulk. A bad row
+once per tick on every stream whose window is full, each stream's evidence accumulates over its
+windows (:mod:`robohealth_mj.runtime.evidence`; reset with the window on a gap), and the alarms
+update in bulk on the accumulated probabilities. A bad row
 never raises: it comes back flagged with its reason. Several rows from one stream in one tick
 (a burst) are taken in order, up to ``max_burst``; the rest are flagged and dropped.
 """
@@ -24,11 +26,13 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
+from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
 
 log = logging.getLogger(__name__)
 
 DECIDED, WARMING, INVALID, NO_MODEL, BUFFERED = 0, 1, 2, 3, 4
+JOINT_SCORES = ("softmax", "sigmoid")  # how joint logits become scores (ONNX metadata)
 
 _FLAGS = np.zeros((schema.N_NODES, 2), np.float32)
 _FLAGS[: schema.N_JOINTS, 0] = 1.0
@@ -44,7 +48,10 @@ class TickResult:
     t: np.ndarray  # [R]
     status: np.ndarray  # [R] DECIDED, WARMING, INVALID, NO_MODEL or BUFFERED (burst catch-up)
     probs: np.ndarray  # [R, C] class probabilities (zero unless decided)
-    joint_scores: np.ndarray  # [R, J] sigmoid joint scores (zero unless decided)
+    accumulated: np.ndarray  # [R, C] the evidence accumulated over windows the alarms read
+    joint_scores: (
+        np.ndarray
+    )  # [R, J] joint scores, softmax or sigmoid as trained (zero unless decided)
     alarm: np.ndarray  # [R] alarms.NONE/RAISED/HELD/CLEARED (decided rows)
     alarm_class: np.ndarray  # [R] alarmed class index, 0 when none
     alarm_joint: np.ndarray  # [R] alarmed joint index, -1 when none
@@ -59,6 +66,7 @@ def _empty(n: int, classes: int, joints: int) -> dict[str, np.ndarray]:
     return {
         "status": np.full(n, INVALID, np.int8),
         "probs": np.zeros((n, classes), np.float32),
+        "accumulated": np.zeros((n, classes), np.float32),
         "joint_scores": np.zeros((n, joints), np.float32),
         "alarm": np.zeros(n, np.int8),
         "alarm_class": np.zeros(n, np.int64),
@@ -79,6 +87,14 @@ def _softmax(z: np.ndarray) -> np.ndarray:
     return e / e.sum(axis=-1, keepdims=True)
 
 
+def joint_scores_from_logits(logits: np.ndarray, kind: str) -> np.ndarray:
+    """``[B, J]`` joint logits -> scores as the model was trained: ``softmax`` over the joints
+    (which joint is at fault) or ``sigmoid`` per joint (is this joint at fault)."""
+    if kind == "softmax":
+        return _softmax(logits)
+    return 0.5 * (1.0 + np.tanh(0.5 * logits))  # sigmoid, no overflow
+
+
 class FleetRuntime:
     """Per-stream windows, bulk validation, one model call per tick, alarms."""
 
@@ -88,6 +104,7 @@ class FleetRuntime:
         *,
         threads: int = 1,
         alarm: AlarmPolicy | None = None,
+        evidence: EvidencePolicy | None = None,
         incremental: bool = True,
         capacity: int = 64,
         max_streams: int = 8192,
@@ -102,11 +119,13 @@ class FleetRuntime:
         capacity = max(1, min(capacity, max_streams))
         self._pool = ThreadPoolExecutor(self.shards) if self.shards > 1 else None
         self.window, self.model_id, self.problem = 16, "none", None
+        self.joint_scores = "softmax"
         self.classes, self.joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
         self.engine: IncrementalEngine | WindowedEngine | None = None
         self.mode = "none"
         self._load(model_path, threads, incremental, capacity)
         self.alarms = AlarmBank(alarm or AlarmPolicy(), len(self.joints), capacity)
+        self.evidence = EvidenceBank(evidence or EvidencePolicy(), len(self.classes), capacity)
         self.last_t = np.full(capacity, -np.inf)
         self.last_index = np.full(capacity, -1, np.int64)
         self.last_seen = np.zeros(capacity, np.int64)
@@ -156,6 +175,10 @@ class FleetRuntime:
 
         self.window = int(meta["window"])
         self.classes, self.joints = meta["classes"], meta["joints"]
+        # models exported before the key existed were all trained with the softmax joint loss
+        self.joint_scores = meta.get("joint_scores", "softmax")
+        if self.joint_scores not in JOINT_SCORES:
+            raise ValueError(f"joint_scores {self.joint_scores!r} is not one of {JOINT_SCORES}")
         if incremental and "incremental_encode" in meta:
             self.engine = IncrementalEngine(
                 session(base64.b64decode(meta["incremental_encode"])),
@@ -207,12 +230,14 @@ class FleetRuntime:
         if self.engine is not None:
             self.engine.reset(np.array([slot]))
         self.alarms.reset(np.array([slot]))
+        self.evidence.reset(np.array([slot]))
         return slot
 
     def _grow(self, capacity: int) -> None:
         if self.engine is not None:
             self.engine.ensure(capacity)
         self.alarms.ensure(capacity)
+        self.evidence.ensure(capacity)
         n = capacity - self.capacity
         self.last_t = np.concatenate([self.last_t, np.full(n, -np.inf)])
         self.last_index = np.concatenate([self.last_index, np.full(n, -1, np.int64)])
@@ -306,8 +331,9 @@ class FleetRuntime:
                 f"gap in sample_index ({int(self.last_index[slot])} -> {new}) or over "
                 f"{self.max_gap_s} s of time; window restarted"
             )
-        if gap.any():
+        if gap.any():  # the window restarts, and the evidence with it
             self.engine.reset(gs[gap])
+            self.evidence.reset(gs[gap])
         self.last_t[gs], self.last_index[gs] = gt, gi
         start = time.perf_counter()
         decide = final[good]
@@ -326,11 +352,13 @@ class FleetRuntime:
         if not len(ready):
             return elapsed
         probs = _softmax(outputs[0])
-        joint_scores = 0.5 * (1.0 + np.tanh(0.5 * outputs[1]))  # sigmoid, no overflow
-        state, alarm, joint = self.alarms.update(ready, probs, joint_scores)
+        joint_scores = joint_scores_from_logits(outputs[1], self.joint_scores)
+        accumulated = self.evidence.update(ready, probs)
+        state, alarm, joint = self.alarms.update(ready, accumulated, joint_scores)
         target = rows[good][full]
         out["status"][target] = DECIDED
         out["probs"][target], out["joint_scores"][target] = probs, joint_scores
+        out["accumulated"][target] = accumulated
         out["alarm"][target], out["alarm_class"][target] = state, alarm
         out["alarm_joint"][target] = joint
         return elapsed
@@ -379,6 +407,7 @@ class FleetRuntime:
             "window": self.window,
             "mode": self.mode,
             "threads": self.threads,
+            "joint_scores": self.joint_scores,
             "problem": self.problem,
         }
 

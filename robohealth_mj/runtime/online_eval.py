@@ -16,6 +16,14 @@ false-positive rate. The operator sees alarms, so the headline figures are the a
 
 Ticks without a decision (window warming up, invalid samples) count towards latency but not
 towards the accuracies.
+
+What the operator acts on is the alarm as it rises, so each detected episode also records whether
+the alarm's class and joint were right *at the tick it rose* (not only eventually). Detection is
+given per class x joint, and, given each tick's joint speeds and torques, per episode whether the
+faulted joint ever moved and whether it carried load: friction on a joint that never moves and
+structural weakening of a joint that carries no load change nothing any channel sees, so those
+episodes are counted apart (``physically_hidden``) and the rest (``observable``) are the ceiling
+a detector can reach.
 """
 
 from __future__ import annotations
@@ -26,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from robohealth_mj import schema
+from robohealth_mj.arm_ratings import rated_torque_nm
 from robohealth_mj.runtime.runtime import HealthDiagnosis
 from robohealth_mj.schema import FaultLabel
 
@@ -40,6 +50,32 @@ class _Episode:
     alarm_tick: int | None = None  # first tick with any alarm up
     alarm_class_tick: int | None = None  # first tick with an alarm of the right class
     alarm_joint_tick: int | None = None  # first tick with an alarm naming the right joint
+    rise_class: str | None = None  # the alarm's class and joint at its first tick in the episode
+    rise_joint: str | None = None
+    peak_speed: float | None = None  # max |velocity| of the faulted joint (rad/s), if known
+    torque_sq: float = 0.0  # sum of its squared torque (N m^2) over the ticks with activity
+    activity_ticks: int = 0
+
+    def rms_torque(self) -> float | None:
+        return (self.torque_sq / self.activity_ticks) ** 0.5 if self.activity_ticks else None
+
+
+# What a fault needs to show at all (see physically_hidden): motion for friction, load for weakening
+MOVED_SPEED = 0.05  # rad/s: 50 x the velocity noise floor
+LOADED_SHARE = 0.05  # RMS torque as a share of the joint's rated torque
+
+
+def physically_hidden(ep: _Episode, rated_torque: np.ndarray) -> bool | None:
+    """Whether nothing about this episode's fault reaches any channel: friction on a joint that
+    never moved, structural weakening of a joint that never carried load (None: not known)."""
+    if ep.peak_speed is None or ep.label.joint is None:
+        return None
+    j = schema.JOINT_NAMES.index(ep.label.joint)
+    if ep.label.fault_class == "friction":
+        return ep.peak_speed < MOVED_SPEED
+    if ep.label.fault_class == "struct_weaken":
+        return ep.rms_torque() < LOADED_SHARE * rated_torque[j]
+    return False
 
 
 @dataclass
@@ -59,7 +95,15 @@ class OnlineEvaluator:
     _tick: int = 0
     _last_faulted: int | None = None
 
-    def update(self, truth: FaultLabel, d: HealthDiagnosis) -> None:
+    def update(
+        self,
+        truth: FaultLabel,
+        d: HealthDiagnosis,
+        speed: np.ndarray | None = None,
+        torque: np.ndarray | None = None,
+    ) -> None:
+        """One tick: its truth, its diagnosis, and (optional) the joints' measured speeds and
+        torques ``[J]`` at this tick, for the physically-hidden strata."""
         tick = self._tick
         self._tick += 1
         current = self.episodes[-1] if self.episodes else None
@@ -75,9 +119,15 @@ class OnlineEvaluator:
                 self.episodes.append(current)
             current.last = tick
             self._last_faulted = tick
+            if speed is not None and torque is not None and truth.joint is not None:
+                j = schema.JOINT_NAMES.index(truth.joint)
+                current.peak_speed = max(current.peak_speed or 0.0, abs(float(speed[j])))
+                current.torque_sq += float(torque[j]) ** 2
+                current.activity_ticks += 1
             if alarm_up:
                 if current.alarm_tick is None:
                     current.alarm_tick = tick
+                    current.rise_class, current.rise_joint = d.alarm_class, d.alarm_joint
                 if current.alarm_class_tick is None and d.alarm_class == truth.fault_class:
                     current.alarm_class_tick = tick
                 if current.alarm_joint_tick is None and d.alarm_joint == truth.joint:
@@ -109,10 +159,17 @@ class OnlineEvaluator:
         by_class: dict[str, list[_Episode]] = defaultdict(list)
         by_severity: dict[str, list[_Episode]] = defaultdict(list)
         by_both: dict[str, list[_Episode]] = defaultdict(list)
+        by_joint: dict[str, list[_Episode]] = defaultdict(list)
+        by_visibility: dict[str, list[_Episode]] = defaultdict(list)
+        rated = rated_torque_nm()
         for ep in self.episodes:
             by_class[ep.label.fault_class].append(ep)
             by_severity[f"{ep.label.severity:g}"].append(ep)
             by_both[f"{ep.label.fault_class}@{ep.label.severity:g}"].append(ep)
+            by_joint[f"{ep.label.fault_class}@{ep.label.joint}"].append(ep)
+            hidden = physically_hidden(ep, rated)
+            if hidden is not None:
+                by_visibility["physically_hidden" if hidden else "observable"].append(ep)
         settled_hours = self.settled * self.tick_s / 3600.0
         return {
             "ticks": self._tick,
@@ -132,6 +189,12 @@ class OnlineEvaluator:
             "alarms_by_class_and_severity": {
                 k: self._summary(v) for k, v in sorted(by_both.items())
             },
+            "alarms_by_class_and_joint": {k: self._summary(v) for k, v in sorted(by_joint.items())},
+            "alarms_by_visibility": {k: self._summary(v) for k, v in sorted(by_visibility.items())},
+            "physically_hidden_episodes": [
+                f"{e.label.fault_class}@{e.label.joint}@{e.label.severity:g}"
+                for e in by_visibility.get("physically_hidden", [])
+            ],
             "detection_latency": self._latency(self.episodes),
             "detection_latency_by_class": {
                 k: self._latency(v) for k, v in sorted(by_class.items())
@@ -148,6 +211,11 @@ class OnlineEvaluator:
             "detected": sum(e.alarm_tick is not None for e in episodes),
         }
         out["detection_rate"] = out["detected"] / len(episodes) if episodes else None
+        detected = [e for e in episodes if e.alarm_tick is not None]
+        right = [e for e in detected if e.rise_class == e.label.fault_class]
+        out["class_right_at_rise"] = len(right)
+        out["right_at_rise"] = sum(e.rise_joint == e.label.joint for e in right)
+        out["right_at_rise_rate"] = out["right_at_rise"] / len(detected) if detected else None
         for name, attr in (("class", "alarm_class_tick"), ("joint", "alarm_joint_tick")):
             ticks = [getattr(e, attr) - e.onset for e in episodes if getattr(e, attr) is not None]
             out[f"{name}_detected"] = len(ticks)

@@ -21,6 +21,7 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.runtime.alarms import STATE_NAMES, AlarmPolicy
+from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import DECIDED, INVALID, FleetRuntime, TickResult
 from robohealth_mj.schema import GraphSample, SchemaError, validate_sample
 
@@ -33,7 +34,10 @@ class HealthDiagnosis:
     valid: bool
     fault_present: bool = False
     fault_class: str | None = None
-    class_probabilities: dict[str, float] = field(default_factory=dict)
+    class_probabilities: dict[str, float] = field(default_factory=dict)  # this window's
+    # ... accumulated over windows (runtime.evidence), what the alarm reads; the window's own
+    # when the evidence has no memory
+    accumulated_probabilities: dict[str, float] = field(default_factory=dict)
     joint_scores: dict[str, float] = field(default_factory=dict)
     localised_joint: str | None = None
     confidence: float = 0.0
@@ -68,6 +72,7 @@ def diagnoses(fleet: FleetRuntime, result: TickResult) -> list[HealthDiagnosis]:
             decide(
                 d, result.probs[k], result.joint_scores[k], int(result.alarm[k]),
                 int(result.alarm_class[k]), int(result.alarm_joint[k]), fleet.classes, fleet.joints,
+                result.accumulated[k],
             )  # fmt: skip
             d.inference_latency_ms = result.inference_ms
         out.append(d)
@@ -83,12 +88,18 @@ def decide(
     alarm_joint: int,
     classes: list[str],
     joints: list[str],
+    accumulated: np.ndarray | None = None,
 ) -> None:
-    """Fill ``d`` with one decided tick: class probabilities ``[C]``, joint scores ``[J]`` and
-    the stream's alarm (state, class index or 0, joint index)."""
+    """Fill ``d`` with one decided tick: class probabilities ``[C]`` (and ``accumulated`` over
+    windows, the window's own if not given), joint scores ``[J]`` and the stream's alarm
+    (state, class index or 0, joint index)."""
     c = int(probs.argmax())
     d.fault_class, d.fault_present, d.confidence = classes[c], c != 0, float(probs[c])
     d.class_probabilities = {n: float(p) for n, p in zip(classes, probs, strict=True)}
+    d.accumulated_probabilities = {
+        n: float(p)
+        for n, p in zip(classes, probs if accumulated is None else accumulated, strict=True)
+    }
     d.joint_scores = {n: float(v) for n, v in zip(joints, scores, strict=True)}
     d.localised_joint = joints[int(scores.argmax())] if d.fault_present else None
     d.alarm = STATE_NAMES[state]
@@ -105,8 +116,11 @@ class ModelRuntime:
         threads: int = 1,
         alarm: AlarmPolicy | None = None,
         incremental: bool = True,
+        evidence: EvidencePolicy | None = None,
     ) -> None:
-        self.fleet = FleetRuntime(model_path, threads=threads, alarm=alarm, incremental=incremental)
+        self.fleet = FleetRuntime(
+            model_path, threads=threads, alarm=alarm, evidence=evidence, incremental=incremental
+        )
         self._queue: list[tuple[int, GraphSample]] = []
 
     @property
