@@ -102,3 +102,59 @@ def test_a_bad_coupling_file_names_itself_and_the_problem(tmp_path, matrix, mess
 def test_coupling_correlation_needs_one_row_per_joint():
     with pytest.raises(ValueError):
         coupling_correlation(DEFAULT_C0[:5], DEFAULT_C0)
+
+
+@pytest.mark.parametrize("sensors", [3, 4, 6, 8])
+def test_a_random_placement_is_one_matrix_per_seed_with_every_joint_distinguishable(sensors):
+    from robohealth_mj.data.graphs import placement_problem, random_coupling
+
+    drawn = [random_coupling(seed, sensors) for seed in range(5)]
+    for seed, c in enumerate(drawn):
+        assert c.shape == (schema.N_JOINTS, sensors) and c.dtype == np.float32
+        np.testing.assert_array_equal(c, random_coupling(seed, sensors))  # same seed, same C
+        assert (c >= 0).all() and (c.sum(axis=1) > 0).all()  # every joint reaches a sensor
+        assert (c.sum(axis=0) > 0).all()  # every sensor hears some joint
+        rows = c / np.linalg.norm(c, axis=1, keepdims=True)
+        assert len({tuple(np.round(r, 3)) for r in rows}) == schema.N_JOINTS  # rows distinct
+        assert placement_problem(c) is None
+    assert len({c.tobytes() for c in drawn}) == 5  # another seed, another placement
+
+
+def test_placement_problems_are_named():
+    from robohealth_mj.data.graphs import placement_problem, random_coupling
+
+    assert placement_problem(DEFAULT_C0) is None
+    twin = DEFAULT_C0.copy()
+    twin[1] = 2.0 * twin[0]  # the same direction: the joints are indistinguishable
+    assert "alike" in placement_problem(twin)
+    deaf = np.hstack([DEFAULT_C0, np.zeros((schema.N_JOINTS, 1), np.float32)])
+    assert "every sensor" in placement_problem(deaf)
+    lost = DEFAULT_C0.copy()
+    lost[2] = 0.0
+    assert "every joint must reach a sensor" in placement_problem(lost)
+    with pytest.raises(ValueError, match="2 to 12 sensors"):
+        random_coupling(0, 13)
+
+
+def test_the_harness_takes_a_seeded_placement_and_only_one_source_of_c0():
+    from robohealth_mj.data.graphs import random_coupling
+
+    g = harness_graph(coupling_seed=7, coupling_sensors=6)
+    np.testing.assert_array_equal(g.coupling, random_coupling(7, 6))
+    assert g.node_names[-1] == "harness_sensor_5" and g.adjacency.shape == (12, 12)
+    with pytest.raises(ValueError, match="set one of coupling, coupling_file, coupling_seed"):
+        harness_graph(coupling=DEFAULT_C0, coupling_seed=7)
+
+
+def test_a_seeded_placement_is_chosen_from_the_command_line():
+    from hydra.utils import instantiate
+
+    from robohealth_mj.config import compose_config
+    from robohealth_mj.data.graphs import random_coupling
+
+    cfg = compose_config(
+        "train", ["graph=harness", "graph.coupling_seed=3", "graph.coupling_sensors=8"]
+    )
+    g = instantiate(cfg.graph)
+    np.testing.assert_array_equal(g.coupling, random_coupling(3, 8))
+    assert len(g.node_names) == schema.N_JOINTS + 8

@@ -78,13 +78,63 @@ def load_coupling(path: str | Path) -> np.ndarray:
     return c
 
 
+def random_coupling(seed: int, sensors: int = 4, joints: int = schema.N_JOINTS) -> np.ndarray:
+    """A placement nobody measured, drawn from ``seed``: ``[joints, sensors]``, non-negative.
+
+    Each joint reaches a primary sensor (weight in [0.6, 1]) and, with probability one half, a
+    second one (weight in [0.2, 0.5]); every sensor is reached by some joint; no two joints'
+    rows are alike (normalised rows at least 0.1 apart), so the joints stay distinguishable
+    through the sensors. Redrawn from the same generator until those hold, so one seed gives
+    one matrix.
+    """
+    if not 2 <= sensors <= 2 * joints:
+        raise ValueError(
+            f"a random placement needs 2 to {2 * joints} sensors (each joint reaches one or two), "
+            f"got {sensors}"
+        )
+    rng = np.random.default_rng([seed, 22])
+    while True:
+        c = np.zeros((joints, sensors), np.float32)
+        primary = rng.permutation(np.resize(rng.permutation(sensors), joints))
+        for j, m in enumerate(primary):
+            c[j, m] = rng.uniform(0.6, 1.0)
+            if rng.random() < 0.5:
+                other = rng.choice([k for k in range(sensors) if k != m])
+                c[j, other] = rng.uniform(0.2, 0.5)
+        if placement_problem(c) is None:
+            return c
+
+
+def placement_problem(c: np.ndarray) -> str | None:
+    """Why a coupling cannot serve as a placement (None: it can)."""
+    if np.any(c < 0) or np.any(c.sum(axis=1) == 0):
+        return "coupling must be >= 0 and every joint must reach a sensor"
+    if np.any(c.sum(axis=0) == 0):
+        return "every sensor must be reached by some joint"
+    rows = c / np.linalg.norm(c, axis=1, keepdims=True)
+    gaps = np.linalg.norm(rows[:, None] - rows[None], axis=-1) + np.eye(len(c)) * 9.0
+    if gaps.min() < 0.1:
+        return "two joints reach the sensors alike (normalised rows closer than 0.1)"
+    return None
+
+
 def harness_graph(
-    coupling: np.ndarray | list | None = None, coupling_file: str | None = None
+    coupling: np.ndarray | list | None = None,
+    coupling_file: str | None = None,
+    coupling_seed: int | None = None,
+    coupling_sensors: int = 4,
 ) -> GraphSpec:
     """Joints keep their backbone; every joint links to every harness sensor (dense bipartite),
-    so message passing is not told the coupling either. C0: the default, a matrix, or a file."""
+    so message passing is not told the coupling either. C0: the default, a matrix, a file, or
+    a random placement of ``coupling_sensors`` sensors drawn from ``coupling_seed``."""
+    given = [k for k, v in (("coupling", coupling), ("coupling_file", coupling_file),
+                            ("coupling_seed", coupling_seed)) if v is not None]  # fmt: skip
+    if len(given) > 1:
+        raise ValueError(f"graph: set one of coupling, coupling_file, coupling_seed (got {given})")
     if coupling_file:
         c = load_coupling(coupling_file)
+    elif coupling_seed is not None:
+        c = random_coupling(int(coupling_seed), int(coupling_sensors))
     else:
         c = DEFAULT_C0 if coupling is None else np.asarray(coupling, dtype=np.float32)
     j, m = c.shape
