@@ -208,3 +208,63 @@ def test_gbdt_reads_only_the_channels_it_is_given():
     np.testing.assert_array_equal(two, again)
     with pytest.raises(ValueError, match="unknown"):
         GradientBoostedTrees(adj, 6, F, 8, channels=["torque"])
+
+
+def _head_with(scores: str, coupling: np.ndarray, seed: int = 0):
+    """An anomaly head whose coupling is ``coupling`` and whose predictor ``f`` outputs zero, so
+    each sensor's residual is its own embedding."""
+    import torch
+
+    from robohealth_mj.models.heads import AnomalyResidualHead
+
+    torch.manual_seed(seed)
+    head = AnomalyResidualHead(8, *coupling.shape, scores=scores)
+    with torch.no_grad():
+        c = torch.as_tensor(coupling, dtype=torch.float32)
+        head.coupling_logits.copy_(torch.log(torch.expm1(c)))  # softplus^-1
+        for p in head.f.parameters():
+            p.zero_()
+    return head
+
+
+def _localised(head, sensor: int) -> int:
+    """The joint the head blames when only ``sensor`` deviates."""
+    import torch
+
+    nodes = torch.zeros(1, head.num_joints + head.num_sensors, 8)
+    nodes[0, head.num_joints + sensor] = 3.0
+    logits, _ = head(nodes)
+    return int(logits.argmax())
+
+
+def test_energy_scores_pin_the_coupling_s_sign_where_signed_scores_do_not():
+    """When one sensor deviates, the joint coupled to it most is to blame. An inverted coupling
+    (``max - C``) blames the joint coupled least. A signed score absorbs the inversion (negate
+    ``g`` and the inverted C localises as well as C0 did); an energy score cannot, whatever its
+    weights: a flipped coupling no longer scores the same."""
+    import torch
+
+    from robohealth_mj.data.graphs import DEFAULT_C0
+
+    c0 = DEFAULT_C0 + 0.05
+    inverted = c0.max() + 0.05 - c0
+    sensor = 1
+    culprit = int(c0[:, sensor].argmax())
+    assert int(inverted[:, sensor].argmax()) != culprit
+    signed = _head_with("signed", c0)
+    if _localised(signed, sensor) != culprit:  # this g scores the deviation low: flip it
+        with torch.no_grad():
+            signed.g[-1].weight.neg_()
+            signed.g[-1].bias.neg_()
+    assert _localised(signed, sensor) == culprit
+    flipped = _head_with("signed", inverted)
+    flipped.g.load_state_dict(signed.g.state_dict())
+    with torch.no_grad():
+        flipped.g[-1].weight.neg_()
+        flipped.g[-1].bias.neg_()
+    assert _localised(flipped, sensor) == culprit  # the sign is not identified
+    for seed in range(20):
+        assert _localised(_head_with("energy", c0, seed), sensor) == culprit
+        assert _localised(_head_with("energy", inverted, seed), sensor) != culprit
+    with pytest.raises(ValueError, match="anomaly_scores must be one of"):
+        _head_with("absolute", c0)

@@ -65,17 +65,33 @@ class AnomalyResidualHead(nn.Module):
     joints; the residual ``r_m = s_m - f(sum_j C_pred_jm h_j)`` is scored by ``g`` and scattered
     back through ``C_scat`` (rows sum to 1 over sensors) to joint logits, and ``||r_m||^2 / H`` to
     a per-joint reconstruction energy for the healthy-data penalty. Works for any M.
+
+    ``scores="signed"`` (the thesis) lets ``g`` score a sensor anything, so a model may localise
+    with an *inverted* C: the anomalous sensor scored low and the joint coupled to it *least*
+    winning. ``scores="energy"`` scores ``||W r_m||^2 / H``: zero for a sensor predicted exactly,
+    growing with its residual, so the joint that wins is the one coupled most to the sensors
+    that deviate, which pins C's sign.
     """
 
+    SCORES = ("signed", "energy")
+
     def __init__(
-        self, hidden: int, num_joints: int, num_sensors: int, init_noise: float = 0.01
+        self,
+        hidden: int,
+        num_joints: int,
+        num_sensors: int,
+        init_noise: float = 0.01,
+        scores: str = "signed",
     ) -> None:
         super().__init__()
+        if scores not in self.SCORES:
+            raise ValueError(f"model.anomaly_scores must be one of {self.SCORES}, got {scores!r}")
         self.num_joints, self.num_sensors = num_joints, num_sensors
         self.init_noise = float(init_noise)
         self.coupling_logits = nn.Parameter(torch.empty(num_joints, num_sensors))
         self.f = mlp(hidden, hidden, hidden)
-        self.g = mlp(hidden, hidden, 1)
+        self.scores = scores
+        self.g = mlp(hidden, hidden, 1) if scores == "signed" else nn.Linear(hidden, hidden, False)
         self.reset_parameters()
 
     def reset_parameters(self) -> None:
@@ -94,7 +110,10 @@ class AnomalyResidualHead(nn.Module):
         c_pred, c_scat = self.normalisations()
         predicted = self.f(torch.einsum("jm,bjh->bmh", c_pred, h))
         residual = s - predicted
-        scores = self.g(residual).squeeze(-1)  # [B, M]
+        if self.scores == "signed":
+            scores = self.g(residual).squeeze(-1)  # [B, M], any sign
+        else:
+            scores = self.g(residual).square().mean(-1)  # [B, M], >= 0, grows with |r_m|
         logits = scores @ c_scat.transpose(0, 1)  # [B, J]
         energy = residual.square().mean(-1) @ c_scat.transpose(0, 1)  # [B, J], per channel
         return logits, energy

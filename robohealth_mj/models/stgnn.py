@@ -46,6 +46,7 @@ class STGNN(nn.Module):
         learned_residual: bool = False,
         spectral_features: bool = False,
         anomaly_head: bool = False,
+        anomaly_scores: str = "signed",
         severity_head: bool = False,
         pos_index: int = schema.feature_index("pos"),
     ) -> None:
@@ -75,7 +76,9 @@ class STGNN(nn.Module):
             max_pool=max_pool,
         )
         self.anomaly = (
-            AnomalyResidualHead(hidden, num_joints, n - num_joints) if anomaly_head else None
+            AnomalyResidualHead(hidden, num_joints, n - num_joints, scores=anomaly_scores)
+            if anomaly_head
+            else None
         )
         self.localise = None if anomaly_head else NodeLocalisationHead(hidden, num_joints, dropout)
         self.severity = SeverityHead(hidden, dropout) if severity_head else None
