@@ -158,10 +158,11 @@ def _healthy_segment_starts(overrides: tuple[str, ...]) -> float:
     return sum(schedule.interval_at(t).scenario is None for t in starts) / len(starts)
 
 
-def test_standard_training_sessions_hold_healthy_segment_starts():
+@pytest.mark.parametrize("corpus", ["standard", "quick"])
+def test_training_sessions_hold_healthy_segment_starts(corpus):
     """A model must see a segment start (arm at rest, payload taken on) while healthy, or it
-    learns that a segment start is a fault. The held-out replay keeps the default schedule."""
-    specs = plan(compose_config("corpus").corpus, [])
+    learns that a segment start is a fault. The held-out replay keeps its schedule."""
+    specs = plan(compose_config("corpus", [f"corpus={corpus}"]).corpus, [])
     train = [s for s in specs if s.role == "train"]
     heldout = next(s for s in specs if s.role == "heldout")
     assert all(_healthy_segment_starts(s.overrides) > 0.3 for s in train)
