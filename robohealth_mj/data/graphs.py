@@ -6,7 +6,7 @@ a ground-truth coupling ``C0 [6, 4]`` that no model is shown.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -35,9 +35,17 @@ class GraphSpec:
     adjacency: np.ndarray  # [N, N]
     num_joints: int
     coupling: np.ndarray | None = None  # C0 [J, M] for the harness
+    sensing: str = "full"  # the sensing profile (data/sensing.py) whose channels the graph keeps
+    channel_mask: np.ndarray | None = None  # [12, F] 1 kept / 0 zeroed, on the schema's nodes
+
+    def with_sensing(self, profile) -> GraphSpec:
+        """This graph reading only the channels ``profile`` (a SensingProfile) names."""
+        return replace(self, sensing=profile.name, channel_mask=profile.mask())
 
     def transform(self, x: np.ndarray) -> np.ndarray:
         """Schema snapshots ``[..., 12, F]`` -> this graph's node features ``[..., N, F]``."""
+        if self.channel_mask is not None:
+            x = (x * self.channel_mask).astype(np.float32)
         if self.coupling is None:
             return x
         j = schema.N_JOINTS
@@ -54,6 +62,8 @@ class GraphSpec:
             "adjacency": self.adjacency.tolist(),
             "num_joints": self.num_joints,
             "coupling": None if self.coupling is None else self.coupling.tolist(),
+            "sensing": self.sensing,
+            "channel_mask": None if self.channel_mask is None else self.channel_mask.tolist(),
         }
 
 

@@ -132,12 +132,15 @@ def load_checkpoint(path: Path | str) -> dict[str, Any]:
 def graph_from_checkpoint(ckpt: dict[str, Any]) -> GraphSpec:
     g = ckpt["graph"]
     coupling = None if g["coupling"] is None else np.asarray(g["coupling"], np.float32)
+    mask = g.get("channel_mask")  # absent before sensing profiles: every channel
     return GraphSpec(
         g["name"],
         tuple(g["node_names"]),
         np.asarray(g["adjacency"], np.float32),
         int(g["num_joints"]),
         coupling,
+        g.get("sensing", "full"),
+        None if mask is None else np.asarray(mask, np.float32),
     )
 
 

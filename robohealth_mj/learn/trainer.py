@@ -137,7 +137,7 @@ def prepare(cfg: DictConfig) -> Prepared:
     if cfg.trainer.get("threads"):
         torch.set_num_threads(int(cfg.trainer.threads))
     device = pick_device(cfg.trainer.device)
-    graph: GraphSpec = instantiate(cfg.graph)
+    graph: GraphSpec = instantiate(cfg.graph).with_sensing(instantiate(cfg.sensing))
     rec = load_recordings(expand_paths(cfg.data.train))
     x = graph.transform(rec.x)
     windows = make_windows(rec, int(cfg.window), cfg.stride)

@@ -39,17 +39,29 @@ PARITY_TOLERANCE = 1e-4
 
 
 class RawInput(nn.Module):
-    """Schema window -> the model's graph (harness mixing) -> training-split z-scores."""
+    """Schema window -> the sensing profile's channels -> the model's graph (harness mixing) ->
+    training-split z-scores."""
 
-    def __init__(self, mean: torch.Tensor, std: torch.Tensor, coupling: np.ndarray | None) -> None:
+    def __init__(
+        self,
+        mean: torch.Tensor,
+        std: torch.Tensor,
+        coupling: np.ndarray | None,
+        channel_mask: np.ndarray | None = None,
+    ) -> None:
         super().__init__()
         self.register_buffer("mean", mean.float().clone())
         self.register_buffer("std", std.float().clone())
+        self.masked = channel_mask is not None
+        if self.masked:
+            self.register_buffer("channel_mask", torch.as_tensor(channel_mask, dtype=torch.float32))
         self.mix = coupling is not None
         if self.mix:
             self.register_buffer("coupling", torch.as_tensor(coupling, dtype=torch.float32))
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
+        if self.masked:
+            x = x * self.channel_mask
         if self.mix:
             j = schema.N_JOINTS
             sensor = schema.SENSOR_CHANNELS
@@ -187,7 +199,7 @@ def export_checkpoint(
             "export here; export a network variant"
         )
     graph = graph_from_checkpoint(ckpt)
-    pre = RawInput(ckpt["norm_mean"], ckpt["norm_std"], graph.coupling).eval()
+    pre = RawInput(ckpt["norm_mean"], ckpt["norm_std"], graph.coupling, graph.channel_mask).eval()
     window = int(ckpt["window"])
     rec = heldout_recording(ckpt, data)
     windows = heldout_windows(rec, window, parity_windows)
@@ -223,6 +235,7 @@ def export_checkpoint(
         code_version=ckpt["code_version"],
         parity_error=f"{error:.3g}",
         joint_scores=joint_score_kind(ckpt),
+        sensing=graph.sensing,
         **incremental,
     )
     attach_metadata(tmp, out, metadata)  # writes one self-contained file

@@ -1,0 +1,91 @@
+"""Sensing profiles: the channels an arm really has, from training through the deployed model."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hydra.utils import instantiate
+
+from robohealth_mj import schema
+from robohealth_mj.config import compose_config
+from robohealth_mj.data.sensing import SensingProfile
+
+J = schema.N_JOINTS
+
+
+def _profile(name: str) -> SensingProfile:
+    return instantiate(compose_config("train", [f"sensing={name}"]).sensing)
+
+
+def test_retrofit_zeroes_exactly_the_joint_channels_it_drops_and_nothing_on_sensors():
+    assert _profile("full").mask() is None
+    mask = _profile("retrofit").mask()
+    dropped = [schema.feature_index(n) for n in ("effort", "pos_error", "effort_residual")]
+    expected = np.ones((schema.N_NODES, schema.N_FEATURES), np.float32)
+    expected[:J, dropped] = 0.0
+    np.testing.assert_array_equal(mask, expected)
+    x = np.random.default_rng(0).normal(size=(5, schema.N_NODES, schema.N_FEATURES))
+    x[:, :J, schema.SENSOR_CHANNELS] = 0.0
+    x[:, J:, schema.STATE_CHANNELS] = 0.0
+    kept = x * mask
+    np.testing.assert_array_equal(kept[:, J:], x[:, J:])  # sensors untouched
+    for name in ("pos", "vel"):
+        k = schema.feature_index(name)
+        np.testing.assert_array_equal(kept[:, :J, k], x[:, :J, k])
+    assert not kept[:, :J, dropped].any()
+
+
+def test_an_unknown_channel_is_refused_by_name():
+    with pytest.raises(ValueError, match=r"sensing odd: joint_channels \['torque'\] unknown"):
+        SensingProfile("odd", joint_channels=("pos", "torque"))
+    with pytest.raises(ValueError, match=r"sensor_channels \['pos'\] unknown"):
+        SensingProfile("odd", sensor_channels=("pos",))
+
+
+def test_a_retrofit_model_never_reads_the_channels_its_arm_lacks(tiny_corpus, tmp_path):
+    """Trained with sensing=retrofit, the checkpoint, the evaluation and the exported model all
+    keep the profile: the deployed model's outputs do not move when effort, tracking error and
+    torque residual do."""
+    import onnxruntime as ort
+
+    from robohealth_mj.data.arrays import load_recordings
+    from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
+    from robohealth_mj.runtime.export import export_checkpoint, read_metadata
+    from robohealth_mj.train import run
+
+    cfg = compose_config(
+        "train",
+        [
+            f"data.train=[{tiny_corpus}/train_*]",
+            f"data.evaluate.heldout={tiny_corpus}/heldout",
+            "data.evaluate.probe=null",
+            "trainer.progress=false",
+            "trainer.epochs=1",
+            "window=8",
+            "graph=harness",
+            "sensing=retrofit",
+            "variant=anomaly_residual",
+            "model.hidden=8",
+        ],
+    )
+    run(cfg, tmp_path / "run")
+    ckpt = tmp_path / "run" / "best.ckpt"
+    graph = graph_from_checkpoint(load_checkpoint(ckpt))
+    assert graph.sensing == "retrofit"
+    np.testing.assert_array_equal(graph.channel_mask, _profile("retrofit").mask())
+    onnx = export_checkpoint(ckpt, tmp_path / "model.onnx")["path"]
+    assert read_metadata(onnx)["sensing"] == "retrofit"
+    rec = load_recordings([tiny_corpus / "heldout" / "graphs.jsonl"])
+    dropped = [schema.feature_index(n) for n in ("effort", "pos_error", "effort_residual")]
+    assert rec.x[:, :J, dropped].any()  # the recording has them; what is learnt from does not
+    assert not graph.transform(rec.x)[:, :J][..., dropped].any()
+    x = np.ascontiguousarray(np.stack([rec.x[k : k + 8] for k in range(0, 400, 40)]))
+    noisy = x.copy()
+    for name in ("effort", "pos_error", "effort_residual"):
+        noisy[:, :, :J, schema.feature_index(name)] += 50.0
+    moved = x.copy()
+    moved[:, :, :J, schema.feature_index("vel")] += 0.5
+    session = ort.InferenceSession(onnx, providers=["CPUExecutionProvider"])
+    out, same, other = (session.run(None, {"x": v})[0] for v in (x, noisy, moved))
+    np.testing.assert_allclose(out, same, atol=1e-5)
+    assert not np.allclose(out, other, atol=1e-3)  # the channels it keeps still count
