@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The faint-faults issue's measurements. Run from the repository root on an otherwise idle machine
-# (the memory-cost benchmark times 50 ms ticks); about 45 min on 2 cores.
+# (the memory-cost benchmark times 50 ms ticks); about an hour on 2 cores.
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
 OUT=results/faint_faults
