@@ -21,7 +21,6 @@ from contextlib import ExitStack
 from datetime import datetime
 from pathlib import Path
 
-import numpy as np
 from omegaconf import DictConfig
 
 from robohealth_mj.atomic import atomic_write_json, atomic_write_text
@@ -35,16 +34,9 @@ from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.export import read_metadata
 from robohealth_mj.runtime.fleet import freeze_startup_heap
-from robohealth_mj.runtime.online_eval import OnlineEvaluator
+from robohealth_mj.runtime.online_eval import OnlineEvaluator, joint_activity
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
-from robohealth_mj.schema import (
-    JOINT_NAMES,
-    FaultLabel,
-    GraphSample,
-    SchemaError,
-    feature_index,
-    validate_sample,
-)
+from robohealth_mj.schema import FaultLabel, GraphSample, SchemaError, validate_sample
 
 
 def sim_stream(
@@ -150,7 +142,8 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
                 bag.write_sample(sample)
                 bag.write_diagnosis(d, runtime.fleet.classes, runtime.fleet.joints)
             if evaluator is not None and truth is not None:
-                evaluator.update(truth, d, *_joint_activity(sample))
+                activity = joint_activity(sample.x) if isinstance(sample, GraphSample) else ()
+                evaluator.update(truth, d, *activity)
             if not cfg.quiet:
                 last = _print(cfg.stream_id, t, d, truth, last)
     if cfg.bag_out:
@@ -180,15 +173,6 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
         f"{_num(alarms['joint_latency_s_median'])} s (medians) -> {out}"
     )
     return result
-
-
-def _joint_activity(sample) -> tuple:
-    """The joints' speeds and torques ``[J]`` of a sample (for the evaluator's physically
-    hidden strata), or nothing for a line that did not parse."""
-    if not isinstance(sample, GraphSample):
-        return ()
-    joints = sample.x[: len(JOINT_NAMES)]
-    return np.abs(joints[:, feature_index("vel")]), joints[:, feature_index("effort")]
 
 
 def _print(stream_id: str, t: float, d: HealthDiagnosis, truth, last: str | None) -> str | None:

@@ -83,9 +83,16 @@ def load_coupling(path: str | Path) -> np.ndarray:
     c = np.asarray(c, dtype=np.float32)
     if c.ndim != 2 or c.shape[0] != schema.N_JOINTS or c.shape[1] < 1:
         raise ValueError(f"{path}: coupling must be [{schema.N_JOINTS}, M], got {c.shape}")
-    if np.any(c < 0) or np.any(c.sum(axis=1) == 0):
-        raise ValueError(f"{path}: coupling must be >= 0 and every joint must reach a sensor")
+    if not _reaches(c):
+        raise ValueError(f"{path}: {_UNREACHED}")
     return c
+
+
+_UNREACHED = "coupling must be >= 0 and every joint must reach a sensor"
+
+
+def _reaches(c: np.ndarray) -> bool:
+    return bool(np.all(c >= 0) and np.all(c.sum(axis=1) > 0))
 
 
 def random_coupling(seed: int, sensors: int = 4, joints: int = schema.N_JOINTS) -> np.ndarray:
@@ -117,8 +124,8 @@ def random_coupling(seed: int, sensors: int = 4, joints: int = schema.N_JOINTS) 
 
 def placement_problem(c: np.ndarray) -> str | None:
     """Why a coupling cannot serve as a placement (None: it can)."""
-    if np.any(c < 0) or np.any(c.sum(axis=1) == 0):
-        return "coupling must be >= 0 and every joint must reach a sensor"
+    if not _reaches(c):
+        return _UNREACHED
     if np.any(c.sum(axis=0) == 0):
         return "every sensor must be reached by some joint"
     rows = c / np.linalg.norm(c, axis=1, keepdims=True)

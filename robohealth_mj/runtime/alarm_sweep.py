@@ -23,7 +23,7 @@ from robohealth_mj.errors import InputError
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
-from robohealth_mj.runtime.online_eval import OnlineEvaluator
+from robohealth_mj.runtime.online_eval import OnlineEvaluator, joint_activity
 from robohealth_mj.runtime.runtime import HealthDiagnosis, decide
 from robohealth_mj.schema import FaultLabel
 
@@ -68,16 +68,8 @@ def replay_decisions(model: str | Path, recording: str | Path) -> Decisions:
             rec.fault_class, rec.fault_joint, rec.severity, rec.active, strict=True
         )
     ]
-    joints = rec.x[:, : schema.N_JOINTS]
-    return Decisions(
-        decided,
-        probs,
-        scores,
-        truth,
-        fleet.window,
-        speed=np.abs(joints[:, :, schema.feature_index("vel")]),
-        torque=joints[:, :, schema.feature_index("effort")].copy(),
-    )
+    speed, torque = joint_activity(rec.x)
+    return Decisions(decided, probs, scores, truth, fleet.window, speed, torque)
 
 
 def accumulate(d: Decisions, evidence: EvidencePolicy) -> np.ndarray:
@@ -99,11 +91,11 @@ def evaluate_policy(
     """The on-line evaluation of ``policy`` (alarms reading the ``evidence`` accumulation of
     the decisions; pass ``accumulated`` to reuse :func:`accumulate`'s result) over precomputed
     decisions."""
+    evidence = evidence or EvidencePolicy()
     if accumulated is None:
-        accumulated = accumulate(d, evidence or EvidencePolicy())
+        accumulated = accumulate(d, evidence)
     bank = AlarmBank(policy, d.joint_scores.shape[1], 1)
-    clearing = (evidence or EvidencePolicy()).clearing_ticks
-    ev = OnlineEvaluator(settle_ticks=d.window + policy.clear_after + clearing)
+    ev = OnlineEvaluator(settle_ticks=d.window + policy.clear_after + evidence.clearing_ticks)
     slot = np.zeros(1, np.int64)
     classes, joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
     for k, truth in enumerate(d.truth):

@@ -65,6 +65,15 @@ MOVED_SPEED = 0.05  # rad/s: 50 x the velocity noise floor
 LOADED_SHARE = 0.05  # RMS torque as a share of the joint's rated torque
 
 
+def joint_activity(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The joints' speeds ``|vel|`` and torques (effort) of snapshots ``x [..., 12, F]``, each
+    ``[..., J]``: what :meth:`OnlineEvaluator.update` takes for the physically hidden strata."""
+    joints = x[..., : schema.N_JOINTS, :]
+    return np.abs(joints[..., schema.feature_index("vel")]), joints[
+        ..., schema.feature_index("effort")
+    ].copy()
+
+
 def physically_hidden(ep: _Episode, rated_torque: np.ndarray) -> bool | None:
     """Whether nothing about this episode's fault reaches any channel: friction on a joint that
     never moved, structural weakening of a joint that never carried load (None: not known)."""
