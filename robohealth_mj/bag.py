@@ -25,7 +25,7 @@ from robohealth_mj.errors import InputError, exit_status
 def _write(args: argparse.Namespace) -> int:
     from robohealth_mj.bags.writer import write_bag
     from robohealth_mj.data.arrays import resolve_recordings
-    from robohealth_mj.data.jsonl import read_samples
+    from robohealth_mj.data.read import read_samples
 
     (source,) = resolve_recordings([args.session])
     out = Path(args.out) if args.out else source.parent / "bag"
@@ -43,7 +43,8 @@ def _write(args: argparse.Namespace) -> int:
 def _info(args: argparse.Namespace) -> int:
     from rosbags.rosbag2 import Reader
 
-    from robohealth_mj.bags.reader import bag_manifest, is_bag
+    from robohealth_mj.bags import is_bag
+    from robohealth_mj.bags.reader import bag_manifest
 
     if not is_bag(args.bag):
         raise FileNotFoundError(f"{args.bag}: not a rosbag2 directory (no metadata.yaml)")

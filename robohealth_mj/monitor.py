@@ -24,7 +24,8 @@ from pathlib import Path
 from omegaconf import DictConfig
 
 from robohealth_mj.atomic import atomic_write_json, atomic_write_text
-from robohealth_mj.bags.reader import is_bag, read_bag_samples
+from robohealth_mj.bags import is_bag
+from robohealth_mj.bags.reader import read_bag_samples
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.bags.writer import BagWriter
 from robohealth_mj.config import compose_config, load_cli_config

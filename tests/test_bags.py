@@ -21,7 +21,7 @@ from robohealth_mj.bags.reader import BagError, bag_manifest, read_bag_samples
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.bags.writer import BagWriter, write_bag
 from robohealth_mj.data.arrays import load_recordings
-from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.data.read import read_samples
 from robohealth_mj.dataset import main as dataset_main
 from robohealth_mj.learn.checkpoint import checkpoint_digest
 from robohealth_mj.monitor import main as monitor_main

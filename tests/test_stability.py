@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 
-from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.data.read import read_samples
 from robohealth_mj.recorder import GRAPHS_FILE, MANIFEST_FILE, record_session
 from robohealth_mj.schema import JOINT_NAMES
 

@@ -32,12 +32,6 @@ class BagError(SchemaError):
     """A bag that cannot be read as recordings; the message names bag, topic and stamp."""
 
 
-def is_bag(path: Path | str) -> bool:
-    """A rosbag2 directory (``metadata.yaml`` beside its storage files)."""
-    p = Path(path)
-    return p.is_dir() and (p / "metadata.yaml").is_file()
-
-
 def _stamp(msg: Any) -> int | None:
     header = getattr(msg, "header", None)
     if header is None:

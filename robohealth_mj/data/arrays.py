@@ -15,8 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj.atomic import atomic_write_bytes
-from robohealth_mj.bags.reader import is_bag
-from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.data.read import is_bag, read_samples
 from robohealth_mj.errors import InputError
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, SCHEMA_VERSION
 

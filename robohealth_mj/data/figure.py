@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.data.read import read_samples
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, N_JOINTS, feature_index
 
 _VIB_ACC = [feature_index(name) for name in ("vib", "acc_x", "acc_y", "acc_z")]

@@ -67,17 +67,10 @@ def format_line(
     )
 
 
-def read_samples(path: Path | str) -> Iterator[GraphSample]:
-    """Yield validated samples; sample_index must increase within each recording run. A rosbag2
-    directory (see :mod:`robohealth_mj.bags`) is read through its topics."""
+def read_jsonl_samples(path: Path | str) -> Iterator[GraphSample]:
+    """Yield validated samples of a GraphSample JSONL file; sample_index must increase within
+    each recording run. (Any kind of recording: :func:`robohealth_mj.data.read.read_samples`.)"""
     path = Path(path)
-    from robohealth_mj.bags.reader import is_bag
-
-    if is_bag(path):
-        from robohealth_mj.bags.reader import read_bag_samples
-
-        yield from read_bag_samples(path)
-        return
     last_index: dict[str, int] = {}
     with path.open("r", encoding="utf-8") as handle:
         for line_no, line in enumerate(handle, start=1):

@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 
 from robohealth_mj.atomic import atomic_write_json
-from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.data.read import read_samples
 from robohealth_mj.schema import SCHEMA_VERSION
 from robohealth_mj.version import code_version
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.data.read import read_samples
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES
 
 
