@@ -12,8 +12,16 @@ from omegaconf import DictConfig, OmegaConf
 CONF_DIR = Path(__file__).resolve().parents[1] / "conf"
 
 
+def register_resolvers() -> None:
+    """``${placement:${graph}}`` in the configs (run directories): see ``placement_name``."""
+    from robohealth_mj.data.graphs import placement_name
+
+    OmegaConf.register_new_resolver("placement", placement_name, replace=True)
+
+
 def compose_config(name: str, overrides: Sequence[str] = ()) -> DictConfig:
     """Compose ``conf/<name>.yaml`` with overrides, leaving Hydra's global state clean."""
+    register_resolvers()
     GlobalHydra.instance().clear()
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
         cfg = compose(config_name=name, overrides=list(overrides))

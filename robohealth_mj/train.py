@@ -17,6 +17,7 @@ import hydra
 from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
+from robohealth_mj.config import register_resolvers
 from robohealth_mj.errors import one_line_errors
 from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 from robohealth_mj.learn.trainer import CHECKPOINT, finished_on_current_data, train_run
@@ -42,6 +43,9 @@ def run(cfg: DictConfig, out_dir: Path) -> dict:
         flush=True,
     )
     return results
+
+
+register_resolvers()
 
 
 @hydra.main(config_path="../conf", config_name="train", version_base="1.3")

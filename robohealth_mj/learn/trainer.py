@@ -23,7 +23,7 @@ from tqdm import tqdm
 from robohealth_mj import schema
 from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.data.arrays import load_recordings, resolve_recordings
-from robohealth_mj.data.graphs import GraphSpec, coupling_correlation
+from robohealth_mj.data.graphs import GraphSpec, coupling_correlation, placement_name
 from robohealth_mj.data.windows import make_windows, normalisation, run_aware_split
 from robohealth_mj.learn.checkpoint import save_checkpoint
 from robohealth_mj.learn.data import WindowTensors
@@ -323,6 +323,12 @@ def train_run(cfg: DictConfig, out_dir: Path) -> dict[str, Any]:
         "window": int(cfg.window),
         "seed": int(cfg.seed),
         "graph": p.graph.name,
+        "sensing": p.graph.sensing,
+        "placement": placement_name(cfg.graph),
+        "anomaly_scores": cfg.model.get("anomaly_scores"),
+        "severity_head": bool(cfg.model.get("severity_head", False)),
+        "device": str(p.device),
+        "threads": torch.get_num_threads(),
         "best_epoch": best_epoch,
         "epochs": len(history),
         "gamma": history[best_epoch - 1].get("gamma"),

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# The thesis's experiment on physics (campaign issue), one block per argument, all into
+# outputs/thesis_physics (a finished run is skipped, so any block resumes after interruption):
+#   bash results/thesis_physics/command.sh corpus matrix matrix_w32 windows harness placements severity report
+# CPU: JOBS parallel runs of one thread each (default 2, for 2 cores). A GPU machine runs the same
+# blocks with TRAIN_ARGS="trainer.device=cuda" JOBS=12 (results/thesis_physics/device.sh).
+set -euo pipefail
+PY=${PY:-.venv/bin/python}
+JOBS=${JOBS:-2}
+ROOT=${ROOT:-outputs/thesis_physics}
+CORPUS=${CORPUS:-outputs/corpus/standard}
+# shellcheck disable=SC2206
+EXTRA=(${TRAIN_ARGS:-})
+train() {
+  $PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs="$JOBS" \
+    trainer.threads=1 trainer.progress=false hydra.sweep.dir="$ROOT" \
+    "data.train=[$CORPUS/train_*]" data.evaluate.heldout="$CORPUS/heldout_seed900" \
+    data.evaluate.probe="$CORPUS/probe_payload_high_seed901" "${EXTRA[@]}" "$@"
+}
+timed() {  # block name, then the command; appends the block's wall time to $ROOT/blocks.tsv
+  local name=$1 t0; shift; t0=$(date +%s)
+  "$@"
+  mkdir -p "$ROOT"; printf '%s\t%s\t%s\t%s\n' "$name" "$(( $(date +%s) - t0 ))" "$JOBS" \
+    "$(hostname)" >>"$ROOT/blocks.tsv"
+}
+for block in "$@"; do
+  case $block in
+    corpus) timed corpus $PY -m robohealth_mj.corpus corpus=standard progress=false ;;
+    matrix) timed matrix train +experiment=thesis_matrix ;;
+    matrix_w32) timed matrix_w32 train +experiment=thesis_matrix_w32 ;;
+    windows) timed windows train +experiment=window_ablation ;;
+    harness) timed harness train +experiment=harness
+             timed harness_coupling train +experiment=harness_coupling ;;
+    placements)
+      for p in 1:3 2:4 3:6 4:8 5:4; do
+        set -- graph.coupling_seed="${p%:*}" graph.coupling_sensors="${p#*:}"
+        timed "placement_${p%:*}" train +experiment=placements "$@" variant=gbdt
+        timed "placement_${p%:*}_coupling" train +experiment=placements "$@" \
+          variant=anomaly_residual model.anomaly_scores=energy
+      done ;;
+    severity) timed severity train +experiment=severity ;;
+    report) $PY -m robohealth_mj.report "$ROOT" ;;
+    *) echo "unknown block: $block" >&2; exit 2 ;;
+  esac
+done
