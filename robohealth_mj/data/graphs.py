@@ -5,11 +5,10 @@ a ground-truth coupling ``C0 [6, 4]`` that no model is shown.
 
 from __future__ import annotations
 
-from typing import Any
-
 import json
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
