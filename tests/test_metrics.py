@@ -82,6 +82,20 @@ def test_severity_mae(metrics):
     assert metrics["severity_mae"] == pytest.approx((0.2 + 0.1 + 0.3) / 11)
 
 
+def test_each_fault_class_reports_its_own_localisation_and_severity_error(metrics):
+    """What a sensing profile hides shows per class: localisation and severity error on that
+    class's faulted windows only; the healthy window's false backlash call does not count."""
+    pc = metrics["per_class"]
+    expected = {"backlash": (1 / 2, 0.1 / 2), "jam": (2 / 3, 0.3 / 3), "sensor_drift": (1 / 2, 0.0),
+                "sensor_noise": (1.0, 0.0)}  # fmt: skip
+    for name, (loc, mae) in expected.items():
+        assert pc[name]["localisation"] == pytest.approx(loc), name
+        assert pc[name]["severity_mae"] == pytest.approx(mae), name
+    assert "localisation" not in pc["none"] and "localisation" not in pc["friction"]
+    # on faulted windows only: the healthy window's 0.2 error is not the head's to answer for
+    assert metrics["severity_mae_faulted"] == pytest.approx((0.1 + 0.3) / 8)
+
+
 def test_severity_strata_hold_the_faulted_windows_of_each_level(metrics):
     strata = metrics["by_severity"]
     assert set(strata) == {"0.3", "0.6", "0.9"}

@@ -2,8 +2,8 @@
 # The thesis's experiment on physics (campaign issue), one block per argument, all into
 # outputs/thesis_physics (a finished run is skipped, so any block resumes after interruption):
 #   bash results/thesis_physics/command.sh corpus matrix matrix_w32 windows harness placements severity report
-# CPU: JOBS parallel runs of one thread each (default 2, for 2 cores). A GPU machine runs the same
-# blocks with TRAIN_ARGS="trainer.device=cuda" JOBS=12 (results/thesis_physics/device.sh).
+# JOBS parallel runs of one thread each (default 2, for 2 cores); TRAIN_ARGS adds overrides to every
+# run (e.g. "trainer.device=cuda variant=mlp,gat"); CORPUS names the corpus directory.
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
 JOBS=${JOBS:-2}

@@ -34,6 +34,9 @@ def _scalar_metrics(
             "recall": float(r[i]),
             "f1": float(f[i]),
             "support": int(support[i]),
+            **_per_class_extras(
+                active & (true_class == i), pred_joint, true_joint, severity_true, severity_pred
+            ),
         }
         for i, name in enumerate(FAULT_CLASSES)
     }
@@ -43,7 +46,23 @@ def _scalar_metrics(
     )
     out["confusion_matrix"] = confusion_matrix(true_class, pred_class, labels=labels).tolist()
     if severity_pred is not None:
-        out["severity_mae"] = float(np.mean(np.abs(severity_pred - severity_true)))
+        error = np.abs(severity_pred - severity_true)
+        out["severity_mae"] = float(np.mean(error))
+        if active.any():
+            out["severity_mae_faulted"] = float(np.mean(error[active]))
+    return out
+
+
+def _per_class_extras(
+    mask: np.ndarray, pred_joint, true_joint, severity_true, severity_pred
+) -> dict[str, float]:
+    """On one class's faulted windows: localisation (what each fault hides from the sensors a
+    profile keeps) and, with a severity head, the severity error."""
+    if not mask.any():
+        return {}
+    out = {"localisation": float(np.mean(pred_joint[mask] == true_joint[mask]))}
+    if severity_pred is not None:
+        out["severity_mae"] = float(np.mean(np.abs(severity_pred[mask] - severity_true[mask])))
     return out
 
 
