@@ -105,6 +105,7 @@ def coupling_report(model: torch.nn.Module, graph: GraphSpec) -> dict[str, Any]:
     learned = head.coupling().detach().cpu().numpy()
     out: dict[str, Any] = {"coupling": learned.round(5).tolist()}
     if graph.coupling is not None:
+        out["coupling_truth"] = np.asarray(graph.coupling).round(5).tolist()
         out["coupling_correlation"] = coupling_correlation(learned, graph.coupling)
     return out
 
