@@ -1,9 +1,12 @@
-"""The campaign report: mean ± std over seeds per (graph, variant, window)."""
+"""The campaign report: mean ± std over seeds per (setting, model, window), in the thesis's
+layout (Tables 6, 7, 8), from hand-made run files and from a tiny real campaign."""
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
+
+import numpy as np
 
 from robohealth_mj.report import build_report
 from robohealth_mj.schema import FAULT_CLASSES
@@ -18,7 +21,7 @@ def _run(
     loc: float,
     corr: float | None = None,
 ) -> None:
-    d = root / graph / variant / "w16" / f"seed{seed}"
+    d = root / graph / "full" / "C0" / variant / "w16" / f"seed{seed}"
     d.mkdir(parents=True)
     (d / "train_summary.json").write_text(
         json.dumps(
@@ -59,6 +62,7 @@ def test_report_aggregates_seeds_and_writes_tables_and_figures(tmp_path):
     _run(tmp_path, "harness", "anomaly_residual", 42, 0.6, 0.5, corr=0.9)
     (tmp_path / "structural" / "gat" / "w16" / "seed42").mkdir(parents=True)  # unfinished run
     text, figures = build_report(tmp_path)
+    assert "### Table 6: every model at W = 16" in text and "### Table 8" in text
     assert "| stgnn_fixed | 16 | 3 | 0.900 ± 0.082 |" in text
     assert "| mlp | 16 | 1 |" in text and "gat" not in text
     assert text.index("| mlp |") < text.index("| stgnn_fixed |")  # thesis order
@@ -67,14 +71,93 @@ def test_report_aggregates_seeds_and_writes_tables_and_figures(tmp_path):
     visibility = text[text.index("### Held-out recall per class") :]
     row = next(line for line in visibility.splitlines() if "| stgnn_fixed |" in line)
     cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[0] == "structural/full/C0"
     assert cells[3:9] == ["0.500 ± 0.000"] * 6  # the six fault classes' recall
     assert cells[9] == "0.700 ± 0.082" and cells[11] == "—"  # sev. 0.3; no 0.9 stratum
     assert cells[12:] == ["0.900 ± 0.082", "0.600 ± 0.082"]  # moving, still
     assert (tmp_path / "report" / "results.md").is_file()
-    assert (tmp_path / "report" / "results.csv").read_text().startswith("graph,variant,window")
+    assert (
+        (tmp_path / "report" / "results.csv")
+        .read_text()
+        .startswith("graph,sensing,placement,variant,window")
+    )
     assert {p.name for p in figures} >= {
         "localisation_by_variant.png",
         "payload_shift.png",
-        "confusion_and_f1.png",
+        "confusion_best_worst_headline.png",
+        "harness_localisation.png",
         "coupling_vs_c0.png",
+    }
+
+
+def _cells(text: str, heading: str, first: str) -> list[str]:
+    """The cells of the row starting with ``first`` in the table under ``heading``."""
+    section = text[text.index(heading) :]
+    row = next(line for line in section.splitlines() if line.startswith(f"| {first} |"))
+    return [c.strip() for c in row.strip("|").split("|")]
+
+
+def test_a_tiny_campaign_goes_through_the_report_into_every_table(tiny_corpus, tmp_path):
+    """Two variants x two seeds (Table 6), a second window (Table 7), the harness with the
+    retrofit profile and sign-pinned scores (Table 8), the severity head, and the cost: real
+    training runs in the campaign's directory layout, and the tables hold their numbers."""
+    from robohealth_mj.config import compose_config
+    from robohealth_mj.data.graphs import placement_name
+    from robohealth_mj.train import run
+
+    def train(*overrides: str) -> dict:
+        cfg = compose_config(
+            "train",
+            [
+                f"data.train=[{tiny_corpus}/train_*]",
+                f"data.evaluate.heldout={tiny_corpus}/heldout",
+                "data.evaluate.probe=null",
+                "trainer.epochs=1",
+                "trainer.progress=false",
+                "model.hidden=8",
+                "window=8",
+                *overrides,
+            ],
+        )
+        label = cfg.variant + ("+severity" if cfg.model.get("severity_head") else "")
+        out = tmp_path / cfg.graph._target_.rsplit(".", 1)[1].removesuffix("_graph")
+        out = out / cfg.sensing.name / placement_name(cfg.graph) / label
+        return run(cfg, out / f"w{cfg.window}" / f"seed{cfg.seed}")
+
+    accuracy = {}
+    for variant in ("mlp", "anomaly_residual"):
+        for seed in (1, 2):
+            result = train(f"variant={variant}", f"seed={seed}")
+            accuracy[variant, seed] = result["heldout"]["metrics"]["accuracy"]
+    train("variant=mlp", "seed=1", "window=16")
+    harness = train(
+        "variant=anomaly_residual",
+        "graph=harness",
+        "sensing=retrofit",
+        "model.anomaly_scores=energy",
+        "seed=1",
+    )
+    train("variant=anomaly_residual", "model.severity_head=true", "seed=1")
+
+    text, figures = build_report(tmp_path)
+    table6 = "### Table 6: every model at W = 8"
+    mean = np.mean([accuracy["mlp", 1], accuracy["mlp", 2]])
+    std = np.std([accuracy["mlp", 1], accuracy["mlp", 2]])
+    cells = _cells(text, table6, "mlp")
+    assert cells[1:4] == ["8", "2", f"{mean:.3f} ± {std:.3f}"]
+    assert _cells(text, table6, "anomaly_residual")[2] == "2"
+    assert _cells(text, "### Table 7", "mlp")[1:3] != ["—", "—"]  # W = 8 and W = 16
+    row8 = _cells(text, "### Table 8", "retrofit")
+    assert row8[:3] == ["retrofit", "C0", "anomaly_residual+energy"]
+    corr = harness["heldout"]["coupling_correlation"]
+    assert row8[8] == f"{corr:.3f} ± 0.000"
+    severity = _cells(text, "### Severity head", "structural/full/C0")
+    assert severity[1] == "anomaly_residual+severity" and severity[4] != "—"
+    assert "### Cost: wall time per run" in text and "7 runs" in text
+    assert {p.name for p in figures} >= {
+        "localisation_by_variant.png",
+        "window_ablation.png",
+        "harness_localisation.png",
+        "coupling_vs_c0.png",
+        "confusion_best_worst_headline.png",
     }

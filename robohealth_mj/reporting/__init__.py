@@ -9,7 +9,9 @@ from robohealth_mj.reporting.figures import figures
 from robohealth_mj.reporting.tables import (
     aggregate,
     collect,
+    cost_markdown,
     markdown,
+    severity_markdown,
     visibility_markdown,
     write_csv,
 )
@@ -24,7 +26,9 @@ def build_report(root: Path) -> tuple[str, list[Path]]:
     rows = aggregate(runs)
     out = root / "report"
     out.mkdir(parents=True, exist_ok=True)
-    text = markdown(rows) + "\n" + visibility_markdown(runs)
+    sections = [markdown(rows), severity_markdown(runs), visibility_markdown(runs),
+                cost_markdown(rows, root)]  # fmt: skip
+    text = "\n".join(s for s in sections if s)
     atomic_write_text(
         out / "results.md",
         f"# Results: {root}\n\n{len(runs)} runs; mean ± std over seeds.\n\n{text}",
