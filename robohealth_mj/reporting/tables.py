@@ -156,6 +156,11 @@ def aggregate(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return rows
 
 
+def _table(title: str, head: list[str]) -> list[str]:
+    """A Markdown table's title and header lines."""
+    return [f"### {title}", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+
+
 _MAIN_HEAD = (
     "| variant | W | seeds | accuracy | fault-present | macro-F1 | localisation | "
     "probe acc. | probe loc. | |γ| | s / run |"
@@ -238,12 +243,7 @@ def table8(rows: list[dict[str, Any]]) -> str:
         "corr(C, C0)",
         *(f"loc. {f}" for f in FAULTS),
     ]
-    out = [
-        "### Table 8: unknown placement (harness graph) by sensing profile and placement",
-        "",
-        "| " + " | ".join(head) + " |",
-        "|" + "---|" * len(head),
-    ]
+    out = _table("Table 8: unknown placement (harness graph) by sensing profile and placement", head)
     for r in sub:
         cells = [
             r["sensing"],
@@ -279,12 +279,7 @@ def severity_markdown(runs: list[dict[str, Any]]) -> str:
         "accuracy",
         "localisation",
     ]
-    out = [
-        "### Severity head: mean absolute error on faulted windows (held-out)",
-        "",
-        "| " + " | ".join(head) + " |",
-        "|" + "---|" * len(head),
-    ]
+    out = _table("Severity head: mean absolute error on faulted windows (held-out)", head)
     keys = dict.fromkeys((r["setting"], r["label"], r["window"]) for r in with_head)
     for setting, label, window in keys:
         members = [
@@ -300,38 +295,22 @@ def severity_markdown(runs: list[dict[str, Any]]) -> str:
             if not group:
                 continue
             has_head = group is members
+
+            def stat(*path, digits=3, needs_head=True, group=group, has_head=has_head) -> str:
+                if needs_head and not has_head:
+                    return "—"
+                return _fmt(_mean_std([_get(m, "heldout", *path) for m in group]), digits)
+
             cells = [
                 setting,
                 name,
                 str(window),
                 str(len(group)),
-                _fmt(_mean_std([_get(m, "heldout", "severity_mae_faulted") for m in group]))
-                if has_head
-                else "—",
-                *(
-                    _fmt(
-                        _mean_std(
-                            [_get(m, "heldout", "per_class", f, "severity_mae") for m in group]
-                        ),
-                        2,
-                    )
-                    if has_head
-                    else "—"
-                    for f in FAULTS
-                ),
-                *(
-                    _fmt(
-                        _mean_std(
-                            [_get(m, "heldout", "by_severity", s, "severity_mae") for m in group]
-                        ),
-                        2,
-                    )
-                    if has_head
-                    else "—"
-                    for s in levels
-                ),
-                _fmt(_mean_std([_get(m, "heldout", "accuracy") for m in group])),
-                _fmt(_mean_std([_get(m, "heldout", "localisation_accuracy") for m in group])),
+                stat("severity_mae_faulted"),
+                *(stat("per_class", f, "severity_mae", digits=2) for f in FAULTS),
+                *(stat("by_severity", s, "severity_mae", digits=2) for s in levels),
+                stat("accuracy", needs_head=False),
+                stat("localisation_accuracy", needs_head=False),
             ]
             out.append("| " + " | ".join(cells) + " |")
     return "\n".join([*out, ""])
