@@ -243,7 +243,7 @@ def table8(rows: list[dict[str, Any]]) -> str:
         "corr(C, C0)",
         *(f"loc. {f}" for f in FAULTS),
     ]
-    out = _table("Table 8: unknown placement (harness graph) by sensing profile and placement", head)
+    out = _table("Table 8: unknown placement (harness graph) by sensing profile, placement", head)
     for r in sub:
         cells = [
             r["sensing"],
