@@ -85,6 +85,48 @@ class MessageFactory:
         )
         return self.DiagnosticArray(header=self.header(t), status=[status])
 
+    def health_status(
+        self, d: Any, classes: list[str], joints: list[str], name: str, hardware_id: str
+    ) -> Any:
+        """A ``HealthDiagnosis`` as one ``DiagnosticStatus``: level from the alarm (OK: none,
+        WARN: a fault decided without an alarm, or an invalid sample, ERROR: an alarm up);
+        class, joint, confidence, alarm state and per-class and per-joint scores as key values."""
+        status = self.Status
+        if d.alarm_class is not None:
+            level, message = status.ERROR, f"ALARM {d.alarm_class} @ {d.alarm_joint} ({d.alarm})"
+        elif not d.valid:
+            level, message = status.WARN, f"invalid sample: {d.reason}"
+        elif d.fault_present:
+            level, message = status.WARN, f"{d.fault_class} @ {d.localised_joint} (no alarm)"
+        elif d.fault_class is None:
+            level, message = status.OK, f"no decision: {d.reason}"
+        else:
+            level, message = status.OK, "healthy"
+        values = {
+            "fault_class": d.fault_class or "",
+            "joint": d.localised_joint or "",
+            "confidence": f"{d.confidence:.4f}",
+            "alarm": d.alarm,
+            "alarm_class": d.alarm_class or "",
+            "alarm_joint": d.alarm_joint or "",
+            "valid": str(d.valid).lower(),
+            "sample_index": "" if d.sample_index is None else d.sample_index,
+            **{f"p.{c}": f"{d.class_probabilities.get(c, 0.0):.4f}" for c in classes},
+            **{f"score.{j}": f"{d.joint_scores.get(j, 0.0):.4f}" for j in joints},
+        }
+        return self.Status(
+            level=np.uint8(level),
+            name=name,
+            message=message,
+            hardware_id=hardware_id,
+            values=[self.KeyValue(key=k, value=str(v)) for k, v in values.items()],
+        )
+
+    def health_diagnosis(self, d: Any, classes: list[str], joints: list[str]) -> Any:
+        """The full diagnosis topic's message (one status, stamped with the sample's time)."""
+        status = self.health_status(d, classes, joints, "health_diagnosis", d.model_id)
+        return self.DiagnosticArray(header=self.header(d.stamp), status=[status])
+
     def sample_messages(self, s: GraphSample, topics: BagTopics) -> list[tuple[str, Any]]:
         """``(topic, message)`` for every topic of one sample."""
         x = s.x.astype(np.float64)

@@ -67,32 +67,7 @@ class BagWriter:
     def write_diagnosis(self, d: Any, classes: list[str], joints: list[str]) -> None:
         """A ``HealthDiagnosis`` on ``health_diagnosis``: level from the alarm (OK: none, WARN: a
         fault decided without an alarm, or an invalid sample, ERROR: an alarm up)."""
-        status = self.messages.Status
-        if d.alarm_class is not None:
-            level, message = status.ERROR, f"ALARM {d.alarm_class} @ {d.alarm_joint} ({d.alarm})"
-        elif not d.valid:
-            level, message = status.WARN, f"invalid sample: {d.reason}"
-        elif d.fault_present:
-            level, message = status.WARN, f"{d.fault_class} @ {d.localised_joint} (no alarm)"
-        elif d.fault_class is None:
-            level, message = status.OK, f"no decision: {d.reason}"
-        else:
-            level, message = status.OK, "healthy"
-        values = {
-            "fault_class": d.fault_class or "",
-            "joint": d.localised_joint or "",
-            "confidence": f"{d.confidence:.4f}",
-            "alarm": d.alarm,
-            "alarm_class": d.alarm_class or "",
-            "alarm_joint": d.alarm_joint or "",
-            "valid": str(d.valid).lower(),
-            "sample_index": "" if d.sample_index is None else d.sample_index,
-            **{f"p.{c}": f"{d.class_probabilities.get(c, 0.0):.4f}" for c in classes},
-            **{f"score.{j}": f"{d.joint_scores.get(j, 0.0):.4f}" for j in joints},
-        }
-        msg = self.messages.diagnostics(
-            d.stamp, level, "health_diagnosis", message, d.model_id, values
-        )
+        msg = self.messages.health_diagnosis(d, classes, joints)
         assert msg.__msgtype__ == DIAGNOSTICS
         self._write(self.topics.health_diagnosis, msg, d.stamp)
 
