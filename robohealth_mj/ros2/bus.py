@@ -57,14 +57,31 @@ def dds_topic(ros_name: str) -> str:
     return "rt/" + ros_name.lstrip("/")
 
 
+_DOMAINS: dict[int, tuple[str, Any]] = {}  # Cyclone allows one configured domain per id
+
+
+def _domain(config: BusConfig) -> Any:
+    from cyclonedds.domain import Domain
+
+    xml = config.xml()
+    known = _DOMAINS.get(config.domain_id)
+    if known is None:
+        known = _DOMAINS[config.domain_id] = (xml, Domain(config.domain_id, xml))
+    elif known[0] != xml:
+        raise ValueError(
+            f"domain {config.domain_id} is already configured otherwise in this process"
+        )
+    return known[1]
+
+
 class Bus:
     """A participant on one domain with the topics, readers and writers made through it."""
 
     def __init__(self, config: BusConfig) -> None:
-        from cyclonedds.domain import Domain, DomainParticipant
+        from cyclonedds.domain import DomainParticipant
 
         self.config = config
-        self._domain = Domain(config.domain_id, config.xml())
+        self._domain = _domain(config)
         self.participant = DomainParticipant(config.domain_id)
         self._topics: dict[str, Any] = {}
 

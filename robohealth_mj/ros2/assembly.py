@@ -1,0 +1,165 @@
+"""One arm's GraphSamples from its topics as messages arrive, in any order across topics.
+
+Stamped topics (joint states, tracking error, each IMU, the ground truth) are keyed by their
+header stamp; a vibration array has no header, so each joint's arrays queue in arrival order (a
+writer's samples arrive in the order written) and the oldest goes with the oldest stamp. A stamp
+is emitted once every topic has its message, in stamp order. What goes wrong on a live bus is
+returned as a problem for that arm, never raised: a stamp older than one already emitted, a stamp
+whose messages stopped coming while newer ones completed (``late_ticks``), a message that does
+not assemble (wrong array length, unknown joint order, NaN), or a second message at one stamp.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from robohealth_mj.bags.messages import sample_from_messages
+from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.schema import FEATURE_NAMES, JOINT_NAMES, NODE_NAMES, FaultLabel, GraphSample
+
+UNKNOWN_TRUTH = FaultLabel("none", None, 0.0, False)
+
+
+@dataclass
+class Assembled:
+    samples: list[GraphSample] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)
+
+
+def _stamp_ns(msg: Any) -> int | None:
+    header = getattr(msg, "header", None)
+    return None if header is None else int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
+
+
+class _Problem(Exception):
+    pass
+
+
+class ArmAssembler:
+    """Assembles one arm's samples; ``topics`` are that arm's (namespaced) topic names."""
+
+    def __init__(
+        self, arm: str, topics: BagTopics, require_truth: bool = True, late_ticks: int = 10
+    ) -> None:
+        self.arm, self.topics = arm, topics
+        self.require_truth, self.late_ticks = require_truth, late_ticks
+        self.vibration = [topics.vibration.format(joint=j) for j in JOINT_NAMES]
+        self.imu = [topics.imu.format(joint=j) for j in JOINT_NAMES]
+        self.stamped = [topics.joint_states, topics.joint_errors, *self.imu]
+        if require_truth:
+            self.stamped.append(topics.fault_state)
+        self.pending: dict[int, dict[str, Any]] = {}
+        self.queues: dict[str, deque] = {t: deque() for t in self.vibration}
+        self.last_emitted: int | None = None
+        self.count = 0
+
+    def topic_names(self) -> list[str]:
+        return [*self.stamped, *self.vibration]
+
+    def add(self, topic: str, msg: Any) -> Assembled:
+        """Take one message; return the samples it completed and any problems."""
+        out = Assembled()
+        if topic in self.queues:
+            self.queues[topic].append(msg)
+        else:
+            stamp = _stamp_ns(msg)
+            if stamp is None:
+                out.problems.append(f"topic '{topic}': message without a header stamp")
+                return out
+            if self.last_emitted is not None and stamp <= self.last_emitted:
+                out.problems.append(
+                    f"topic '{topic}': stamp {stamp / 1e9:.6f} s is not after the last sample "
+                    f"({self.last_emitted / 1e9:.6f} s): stamps went backwards"
+                )
+                return out
+            slot = self.pending.setdefault(stamp, {})
+            if topic in slot:
+                out.problems.append(
+                    f"topic '{topic}': a second message at stamp {stamp / 1e9:.6f} s"
+                )
+                return out
+            slot[topic] = msg
+        self._drain(out)
+        return out
+
+    def _stamped_in(self, slot: dict[str, Any]) -> bool:
+        return all(t in slot for t in self.stamped)
+
+    def _complete(self, slot: dict[str, Any]) -> bool:
+        return all(t in slot for t in self.stamped) and all(self.queues[t] for t in self.vibration)
+
+    def _drain(self, out: Assembled) -> None:
+        while self.pending:
+            oldest = min(self.pending)
+            slot = self.pending[oldest]
+            if self._complete(slot):
+                del self.pending[oldest]
+                vibs = [self.queues[t].popleft() for t in self.vibration]
+                self.last_emitted = oldest
+                try:
+                    out.samples.append(self._sample(oldest, slot, vibs))
+                except _Problem as exc:
+                    out.problems.append(str(exc))
+                continue
+            newer_complete = sum(
+                1
+                for s, sl in self.pending.items()
+                if s > oldest and all(t in sl for t in self.stamped)
+            )
+            if newer_complete < self.late_ticks:
+                return
+            missing = [t for t in self.stamped if t not in slot] or [
+                t for t in self.vibration if not self.queues[t]
+            ]
+            del self.pending[oldest]
+            self.last_emitted = oldest
+            out.problems.append(
+                f"topic '{missing[0]}' at stamp {oldest / 1e9:.6f} s: message missing "
+                f"({len(missing)} topics)"
+            )
+
+    def _sample(self, stamp: int, slot: dict[str, Any], vibs: list[Any]) -> GraphSample:
+        at = f"at stamp {stamp / 1e9:.6f} s"
+
+        def where(key, message: str) -> _Problem:
+            topic = getattr(self.topics, key) if isinstance(key, str) else self.vibration[key[1]]
+            return _Problem(f"topic '{topic}' {at}: {message}")
+
+        truth = slot.get(self.topics.fault_state) if self.require_truth else None
+        try:
+            sample = sample_from_messages(
+                stamp / 1e9,
+                slot[self.topics.joint_states],
+                slot[self.topics.joint_errors],
+                [slot[t] for t in self.imu],
+                vibs,
+                truth if truth is not None else _NoTruth(self.arm, self.count),
+                where,
+            )
+        except (AttributeError, TypeError, ValueError) as exc:
+            raise _Problem(f"{at}: malformed message ({exc})") from None
+        bad = np.argwhere(~np.isfinite(sample.x))
+        if bad.size:
+            node, feat = bad[0]
+            raise _Problem(f"{at}: NaN or Inf in x[{NODE_NAMES[node]}].{FEATURE_NAMES[feat]}")
+        self.count += 1
+        return sample
+
+
+class _NoTruth:
+    """Stands in for ``/fault_state`` on a robot that publishes no ground truth: the sample is
+    numbered by arrival and labelled healthy-unknown."""
+
+    def __init__(self, arm: str, index: int) -> None:
+        from types import SimpleNamespace
+
+        values = [
+            SimpleNamespace(key=k, value=v)
+            for k, v in (("class", "none"), ("joint", ""), ("severity", "0"), ("active", "false"),
+                         ("sample_index", str(index)), ("segment", "{}"))
+        ]  # fmt: skip
+        self.status = [SimpleNamespace(hardware_id=arm, values=values)]

@@ -1,0 +1,167 @@
+"""The monitor as a live ROS 2 participant, and simulated arms publishing as a robot would.
+
+``MonitorNode`` subscribes to each arm's topics (the bag layout under ``/<arm>``), assembles
+samples by stamp (:mod:`robohealth_mj.ros2.assembly`), diagnoses every arm in one batched runtime
+step per poll, and publishes each diagnosis on ``/<arm>/health_diagnosis`` and, at a fixed
+period, one ``DiagnosticStatus`` per arm on ``/diagnostics`` (level from the alarm; WARN with the
+reason for a bad message; STALE when an arm stops publishing). A bad message marks its arm only.
+"""
+
+from __future__ import annotations
+
+import time
+import zlib
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from robohealth_mj.bags.messages import MessageFactory
+from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.ros2.assembly import ArmAssembler
+from robohealth_mj.ros2.bus import Bus
+from robohealth_mj.ros2.idl import TYPES, IdlStore
+from robohealth_mj.schema import GraphSample
+
+DIAGNOSTICS_TOPIC = "/diagnostics"
+
+
+def arm_topics(arm: str, topics: BagTopics | None = None) -> BagTopics:
+    """The bag layout's topic names under the arm's namespace (``/arm1/joint_states`` …)."""
+    base = topics or BagTopics.load()
+    fields = {k: f"/{arm}/{v.lstrip('/')}" for k, v in vars(base).items()}
+    return replace(base, **fields)
+
+
+def in_partition(arm: str, partition: str | None) -> bool:
+    """``partition="k/n"``: this process's share of a fleet split across ``n`` processes by a
+    stable hash of the arm name (no coordinator: every process computes the same split)."""
+    if not partition:
+        return True
+    k, n = (int(v) for v in partition.split("/"))
+    if not 0 <= k < n:
+        raise ValueError(f"partition {partition!r}: need k/n with 0 <= k < n")
+    return zlib.crc32(arm.encode()) % n == k
+
+
+class ArmPublisher:
+    """One simulated or replayed arm publishing its samples as a robot driver would."""
+
+    def __init__(self, bus: Bus, arm: str, topics: BagTopics | None = None) -> None:
+        self.arm, self.topics = arm, arm_topics(arm, topics)
+        self.factory = MessageFactory(IdlStore())
+        self.writers = {
+            name: bus.writer(name, TYPES[kind])
+            for name, kind in self.topics.sample_topics().items()
+        }
+
+    def publish(self, sample: GraphSample) -> None:
+        for topic, msg in self.factory.sample_messages(sample, self.topics):
+            self.writers[topic].write(msg)
+
+
+@dataclass
+class ArmState:
+    """What ``/diagnostics`` says of one arm."""
+
+    assembler: ArmAssembler
+    readers: list[tuple[str, Any]]
+    last_sample_wall: float | None = None
+    last_diagnosis: Any = None
+    problem: str | None = None
+    problems: int = 0
+    samples: int = 0
+    diagnoses: list[Any] = field(default_factory=list)
+
+
+class MonitorNode:
+    """Diagnoses a fleet of arms on the bus; ``poll`` once per loop iteration."""
+
+    def __init__(
+        self,
+        bus: Bus,
+        runtime: Any,
+        arms: list[str],
+        topics: BagTopics | None = None,
+        require_truth: bool = True,
+        stale_s: float = 1.0,
+        keep_diagnoses: bool = False,
+    ) -> None:
+        self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
+        self.keep_diagnoses = keep_diagnoses
+        self.factory = MessageFactory(IdlStore())
+        self.arms: dict[str, ArmState] = {}
+        self.diagnosis_writers: dict[str, Any] = {}
+        for arm in arms:
+            names = arm_topics(arm, topics)
+            assembler = ArmAssembler(arm, names, require_truth=require_truth)
+            kinds = names.sample_topics()
+            readers = [(t, bus.reader(t, TYPES[kinds[t]])) for t in assembler.topic_names()]
+            self.arms[arm] = ArmState(assembler, readers)
+            self.diagnosis_writers[arm] = bus.writer(names.health_diagnosis, TYPES[
+                "diagnostic_msgs/msg/DiagnosticArray"])  # fmt: skip
+        self.diagnostics = bus.writer(
+            DIAGNOSTICS_TOPIC, TYPES["diagnostic_msgs/msg/DiagnosticArray"]
+        )
+
+    def poll(self, max_per_reader: int = 256) -> int:
+        """Take what has arrived, diagnose the completed samples; returns how many."""
+        now = time.monotonic()
+        submitted: list[tuple[str, GraphSample]] = []
+        for arm, state in self.arms.items():
+            for topic, reader in state.readers:
+                for msg in reader.take(N=max_per_reader):
+                    got = state.assembler.add(topic, msg)
+                    for problem in got.problems:
+                        state.problem, state.problems = problem, state.problems + 1
+                    for sample in got.samples:
+                        submitted.append((arm, sample))
+                        state.last_sample_wall = now
+        for arm, sample in submitted:
+            invalid = self.runtime.submit(arm, sample)
+            if invalid is not None:
+                self._record(arm, invalid)
+        for d in self.runtime.tick():
+            self._record(d.stream_id, d)
+        return len(submitted)
+
+    def _record(self, arm: str, d: Any) -> None:
+        state = self.arms[arm]
+        state.last_diagnosis, state.samples = d, state.samples + 1
+        if self.keep_diagnoses:
+            state.diagnoses.append(d)
+        fleet = self.runtime.fleet
+        self.diagnosis_writers[arm].write(
+            self.factory.health_diagnosis(d, fleet.classes, fleet.joints)
+        )
+
+    def arm_status(self, arm: str, now: float) -> Any:
+        """One arm's ``DiagnosticStatus``: STALE without recent samples, WARN with the last
+        problem, else the last diagnosis's level."""
+        state, status = self.arms[arm], self.factory.Status
+        fleet = self.runtime.fleet
+        d = state.last_diagnosis
+        if d is not None:
+            msg = self.factory.health_status(
+                d, fleet.classes, fleet.joints, f"robohealth/{arm}", arm
+            )
+        else:
+            msg = status(level=status.STALE, name=f"robohealth/{arm}", message="no sample yet",
+                         hardware_id=arm, values=[])  # fmt: skip
+        if state.last_sample_wall is not None and now - state.last_sample_wall > self.stale_s:
+            msg.level = status.STALE
+            msg.message = f"no sample for {now - state.last_sample_wall:.1f} s"
+        elif state.problem is not None:
+            msg.level = max(int(msg.level), status.WARN)
+            msg.message = f"bad input: {state.problem}"
+        msg.values.append(self.factory.KeyValue(key="problems", value=str(state.problems)))
+        return msg
+
+    def publish_diagnostics(self, stamp: float) -> Any:
+        now = time.monotonic()
+        array = self.factory.DiagnosticArray(
+            header=self.factory.header(stamp),
+            status=[self.arm_status(arm, now) for arm in self.arms],
+        )
+        self.diagnostics.write(array)
+        for state in self.arms.values():
+            state.problem = None  # a problem is reported once, then the arm recovers
+        return array
