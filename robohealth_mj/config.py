@@ -29,10 +29,15 @@ def compose_config(name: str, overrides: Sequence[str] = ()) -> DictConfig:
     return cfg
 
 
-def load_cli_config(name: str, argv: Sequence[str], prog: str) -> DictConfig:
+def load_cli_config(
+    name: str, argv: Sequence[str], prog: str, include: Sequence[str] = ()
+) -> DictConfig:
     """``conf/<name>.yaml`` with ``key=value`` overrides, for the small tools that are not Hydra
-    apps (``model=`` there names a file, not the training ``model`` config group)."""
+    apps (``model=`` there names a file, not the training ``model`` config group). Each name in
+    ``include`` adds ``conf/<include>.yaml`` under that key (one block shared by several tools)."""
     cfg = OmegaConf.load(CONF_DIR / f"{name}.yaml")
+    for key in include:
+        cfg[key] = OmegaConf.load(CONF_DIR / f"{key}.yaml")
     keys = [a.split("=", 1)[0] for a in argv]
     unknown = [k for k in keys if k.split(".")[0] not in cfg]
     if unknown or any("=" not in a for a in argv):

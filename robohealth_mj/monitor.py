@@ -3,6 +3,7 @@
     python -m robohealth_mj.monitor model=model.onnx source=sim duration_s=120
     python -m robohealth_mj.monitor model=model.onnx source=replay file=graphs.jsonl speed=10
     python -m robohealth_mj.monitor model=model.onnx source=replay file=... evaluate=true
+    python -m robohealth_mj.monitor model=model.onnx source=ros2 ros2.count=4 duration_s=0
 
 Prints each change of diagnosis and every alarm raised or cleared (debouncing and hysteresis:
 ``alarm.raise_after``, ``alarm.clear_after``, ``alarm.min_confidence``, ``alarm.clear_confidence``;
@@ -13,10 +14,8 @@ detection latency to class and joint, per fault class and severity.
 
 from __future__ import annotations
 
-import json
 import sys
 import time
-from collections.abc import Iterator
 from contextlib import ExitStack
 from datetime import datetime
 from pathlib import Path
@@ -25,10 +24,9 @@ from omegaconf import DictConfig
 
 from robohealth_mj.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.bags import is_bag
-from robohealth_mj.bags.reader import read_bag_samples
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.bags.writer import BagWriter
-from robohealth_mj.config import compose_config, load_cli_config
+from robohealth_mj.config import load_cli_config
 from robohealth_mj.errors import InputError, one_line_errors
 from robohealth_mj.reporting.online import online_markdown
 from robohealth_mj.runtime.alarms import AlarmPolicy
@@ -37,38 +35,8 @@ from robohealth_mj.runtime.export import read_metadata
 from robohealth_mj.runtime.fleet import freeze_startup_heap
 from robohealth_mj.runtime.online_eval import OnlineEvaluator, joint_activity
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
-from robohealth_mj.schema import FaultLabel, GraphSample, SchemaError, validate_sample
-
-
-def sim_stream(
-    overrides: list[str], duration_s: float
-) -> Iterator[tuple[float, GraphSample, FaultLabel]]:
-    """GraphSamples straight from the simulator (with its fault schedule)."""
-    from robohealth_mj.recorder import build_simulator, chunk_features, segment_info
-
-    sim = build_simulator(compose_config("record", ["session.progress=false", *overrides]))
-    for chunk in sim.run(round(duration_s / sim.tick_s)):
-        first, x, segment = sim.tick - len(chunk.t), chunk_features(chunk), segment_info(sim, chunk)
-        for k, t in enumerate(chunk.t.tolist()):
-            sample = GraphSample("sim", first + k, t, x[k].astype("float32"), chunk.fault, segment)
-            yield t, sample, chunk.fault
-
-
-def replay_stream(path: str) -> Iterator[tuple[float, str | GraphSample, FaultLabel | None]]:
-    """``(t, sample, truth)`` per recorded sample: a graphs.jsonl's lines (a line that does not
-    parse goes to the runtime as it is, which flags it) or a bag's assembled samples."""
-    if is_bag(path):
-        for sample in read_bag_samples(path):
-            yield sample.t, sample, sample.fault
-        return
-    with open(path, encoding="utf-8") as handle:
-        for number, line in enumerate(handle, start=1):
-            try:
-                sample = validate_sample(json.loads(line), source=path, line=number)
-            except (ValueError, SchemaError):
-                yield 0.0, line, None
-                continue
-            yield sample.t, sample, sample.fault
+from robohealth_mj.runtime.sources import replay_stream, sim_stream
+from robohealth_mj.schema import GraphSample
 
 
 def describe(d: HealthDiagnosis) -> str:
@@ -82,7 +50,7 @@ def describe(d: HealthDiagnosis) -> str:
 
 
 def load_config(argv: list[str]) -> DictConfig:
-    return load_cli_config("monitor", argv, "robohealth_mj.monitor")
+    return load_cli_config("monitor", argv, "robohealth_mj.monitor", include=("ros2",))
 
 
 def main(argv: list[str] | None = None) -> dict | None:
@@ -115,6 +83,14 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
         cfg.model, threads=cfg.threads, alarm=policy, incremental=cfg.incremental,
         evidence=evidence,
     )  # fmt: skip
+    if cfg.source == "ros2":
+        from robohealth_mj.ros2.live import run_monitor
+
+        counts = run_monitor(cfg.ros2, runtime, cfg.duration_s or None)
+        for arm, c in counts.items():
+            last = f" (last: {c['last_problem']})" if c["last_problem"] else ""
+            print(f"{arm}: {c['samples']} samples diagnosed, {c['problems']} bad inputs{last}")
+        return None
     if cfg.source == "sim":
         stream = sim_stream(list(cfg.sim_overrides), cfg.duration_s)
     elif cfg.source == "replay":
@@ -125,7 +101,7 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
             )
         stream = replay_stream(cfg.file)
     else:
-        raise InputError(f"source must be sim or replay, got {cfg.source!r}")
+        raise InputError(f"source must be sim, replay or ros2, got {cfg.source!r}")
     freeze_startup_heap()
     settle = runtime.window + policy.clear_after + evidence.clearing_ticks
     evaluator = OnlineEvaluator(settle_ticks=settle) if cfg.evaluate else None

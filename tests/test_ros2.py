@@ -143,3 +143,62 @@ def test_simulated_arms_on_loopback_are_diagnosed_and_reported_on_diagnostics(de
     assert all(s.level == 3 and "no sample for" in s.message for s in stale.status)
     for bus in (robot, monitor_bus, listener):
         bus.close()
+
+
+def test_two_monitor_processes_split_four_arms_and_stop_cleanly_on_sigterm(deployed, tmp_path):
+    """The command line end to end: a simulated robot process replays four arms; two monitor
+    processes share them by hash partition (no arm diagnosed twice, none left out, every sample
+    diagnosed) and end cleanly on SIGTERM with their counts."""
+    import signal
+    import subprocess
+    import sys
+
+    lines = deployed["heldout"].read_text().splitlines(keepends=True)[:100]
+    short = tmp_path / "short.jsonl"
+    short.write_text("".join(lines))
+    common = [f"ros2.domain_id={next(_DOMAINS)}", "ros2.interface=127.0.0.1", "ros2.count=4"]
+    monitors = [
+        subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "robohealth_mj.monitor",
+                f"model={deployed['structural_onnx']}",
+                "source=ros2",
+                "duration_s=0",
+                *common,
+                f"ros2.partition={k}/2",
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        for k in range(2)
+    ]
+    try:
+        for m in monitors:  # each says it is listening once its participant exists
+            assert m.stdout.readline().startswith("ros2 monitor:")
+        robot = subprocess.run(
+            [sys.executable, "-m", "robohealth_mj.robot", "source=replay", f"file={short}",
+             "speed=4", "discovery_s=2", *common],
+            capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+        assert robot.returncode == 0, robot.stdout + robot.stderr
+        assert "published 100 ticks" in robot.stdout
+        time.sleep(2)
+        for m in monitors:
+            m.send_signal(signal.SIGTERM)
+        outputs = [m.communicate(timeout=60)[0] for m in monitors]
+    finally:
+        for m in monitors:
+            m.kill() if m.poll() is None else None
+    assert [m.returncode for m in monitors] == [0, 0], outputs
+    counts = [
+        {line.split(":")[0]: line for line in out.splitlines() if " samples diagnosed" in line}
+        for out in outputs
+    ]
+    assert set(counts[0]).isdisjoint(counts[1])
+    assert set(counts[0]) | set(counts[1]) == {"arm1", "arm2", "arm3", "arm4"}
+    for share in counts:
+        for line in share.values():
+            assert ": 100 samples diagnosed, 0 bad inputs" in line

@@ -63,10 +63,11 @@ class ArmState:
     """What ``/diagnostics`` says of one arm."""
 
     assembler: ArmAssembler
-    readers: list[tuple[str, Any]]
+    readers: list[tuple[str, type, Any]]  # (topic, message class, reader)
     last_sample_wall: float | None = None
     last_diagnosis: Any = None
-    problem: str | None = None
+    problem: str | None = None  # the latest, until /diagnostics has reported it
+    last_problem: str | None = None
     problems: int = 0
     samples: int = 0
     diagnoses: list[Any] = field(default_factory=list)
@@ -94,7 +95,10 @@ class MonitorNode:
             names = arm_topics(arm, topics)
             assembler = ArmAssembler(arm, names, require_truth=require_truth)
             kinds = names.sample_topics()
-            readers = [(t, bus.reader(t, TYPES[kinds[t]])) for t in assembler.topic_names()]
+            readers = [
+                (t, TYPES[kinds[t]], bus.reader(t, TYPES[kinds[t]]))
+                for t in assembler.topic_names()
+            ]
             self.arms[arm] = ArmState(assembler, readers)
             self.diagnosis_writers[arm] = bus.writer(names.health_diagnosis, TYPES[
                 "diagnostic_msgs/msg/DiagnosticArray"])  # fmt: skip
@@ -107,11 +111,14 @@ class MonitorNode:
         now = time.monotonic()
         submitted: list[tuple[str, GraphSample]] = []
         for arm, state in self.arms.items():
-            for topic, reader in state.readers:
+            for topic, kind, reader in state.readers:
                 for msg in reader.take(N=max_per_reader):
+                    if not isinstance(msg, kind):
+                        continue  # an instance-state notice (a writer went away), not data
                     got = state.assembler.add(topic, msg)
                     for problem in got.problems:
-                        state.problem, state.problems = problem, state.problems + 1
+                        state.problem = state.last_problem = problem
+                        state.problems += 1
                     for sample in got.samples:
                         submitted.append((arm, sample))
                         state.last_sample_wall = now
