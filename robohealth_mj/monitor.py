@@ -84,13 +84,7 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
         evidence=evidence,
     )  # fmt: skip
     if cfg.source == "ros2":
-        from robohealth_mj.ros2.live import run_monitor
-
-        counts = run_monitor(cfg.ros2, runtime, cfg.duration_s or None)
-        for arm, c in counts.items():
-            last = f" (last: {c['last_problem']})" if c["last_problem"] else ""
-            print(f"{arm}: {c['samples']} samples diagnosed, {c['problems']} bad inputs{last}")
-        return None
+        return _monitor_ros2(cfg, runtime, policy, evidence)
     if cfg.source == "sim":
         stream = sim_stream(list(cfg.sim_overrides), cfg.duration_s)
     elif cfg.source == "replay":
@@ -149,6 +143,36 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
         f"{_num(alarms['class_latency_s_median'])} s, to joint "
         f"{_num(alarms['joint_latency_s_median'])} s (medians) -> {out}"
     )
+    return result
+
+
+def _monitor_ros2(
+    cfg: DictConfig, runtime: ModelRuntime, policy: AlarmPolicy, evidence: EvidencePolicy
+) -> dict | None:
+    """``source=ros2``: live arms on the bus; with ``evaluate``, one on-line evaluation per arm
+    against its ``fault_state``, as for a replay."""
+    from robohealth_mj.ros2.live import run_monitor
+
+    settle = runtime.window + policy.clear_after + evidence.clearing_ticks
+    evaluators: dict[str, OnlineEvaluator] = {}
+
+    def evaluate(arm: str, sample: GraphSample, d: HealthDiagnosis) -> None:
+        if arm not in evaluators:
+            evaluators[arm] = OnlineEvaluator(settle_ticks=settle)
+        evaluators[arm].update(sample.fault, d, *joint_activity(sample.x))
+
+    counts = run_monitor(cfg.ros2, runtime, cfg.duration_s or None,
+                         evaluate if cfg.evaluate else None)  # fmt: skip
+    for arm, c in counts.items():
+        last = f" (last: {c['last_problem']})" if c["last_problem"] else ""
+        print(f"{arm}: {c['samples']} samples diagnosed, {c['problems']} bad inputs{last}")
+    if not cfg.evaluate:
+        return None
+    result = {arm: e.result() for arm, e in evaluators.items()}
+    stamp = datetime.now().strftime("%Y-%m-%d_%H-%M-%S")
+    out = Path(cfg.out or Path("outputs/monitor") / stamp / "online_eval_ros2.json")
+    atomic_write_json(out, {"model": runtime.describe(), "source": "ros2", "arms": result})
+    print(f"on-line evaluation of {len(result)} arms -> {out}")
     return result
 
 

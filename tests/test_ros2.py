@@ -5,6 +5,7 @@ message marks its arm and nothing else. Skipped, with the reason, where cycloned
 from __future__ import annotations
 
 import itertools
+import json
 import os
 import time
 
@@ -168,6 +169,8 @@ def test_two_monitor_processes_split_four_arms_and_stop_cleanly_on_sigterm(deplo
                 "duration_s=0",
                 *common,
                 f"ros2.partition={k}/2",
+                "evaluate=true",
+                f"out={tmp_path / f'ros2_{k}.json'}",
             ],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
@@ -202,3 +205,17 @@ def test_two_monitor_processes_split_four_arms_and_stop_cleanly_on_sigterm(deplo
     for share in counts:
         for line in share.values():
             assert ": 100 samples diagnosed, 0 bad inputs" in line
+    # the on-line evaluation over DDS is the replay's, arm by arm
+    from robohealth_mj.monitor import main as monitor_main
+
+    replay = monitor_main([f"model={deployed['structural_onnx']}", "source=replay",
+                           f"file={short}", "evaluate=true", "quiet=true",
+                           f"out={tmp_path / 'replay.json'}"])  # fmt: skip
+    live = {}
+    for k in range(2):
+        assert (tmp_path / f"ros2_{k}.json").is_file(), outputs[k]
+        live |= json.loads((tmp_path / f"ros2_{k}.json").read_text())["arms"]
+    assert set(live) == {"arm1", "arm2", "arm3", "arm4"}
+    for result in live.values():
+        for key in ("online_accuracy", "localisation_accuracy", "alarms", "false_alarm_rate"):
+            assert result[key] == replay[key], key

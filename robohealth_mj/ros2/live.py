@@ -7,7 +7,7 @@ from __future__ import annotations
 import signal
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
@@ -51,8 +51,14 @@ def arm_names(cfg: DictConfig) -> list[str]:
     return [a for a in arms if in_partition(a, cfg.partition)]
 
 
-def run_monitor(cfg: DictConfig, runtime: Any, duration_s: float | None) -> dict[str, Any]:
-    """Diagnose the configured arms until the duration ends or a signal comes."""
+def run_monitor(
+    cfg: DictConfig,
+    runtime: Any,
+    duration_s: float | None,
+    on_diagnosis: Callable[[str, GraphSample, Any], None] | None = None,
+) -> dict[str, Any]:
+    """Diagnose the configured arms until the duration ends or a signal comes; each diagnosis
+    also goes to ``on_diagnosis(arm, sample, diagnosis)`` (the on-line evaluation)."""
     require_dds()
     from robohealth_mj.ros2.bus import Bus
     from robohealth_mj.ros2.node import MonitorNode
@@ -62,7 +68,7 @@ def run_monitor(cfg: DictConfig, runtime: Any, duration_s: float | None) -> dict
         raise ValueError("ros2: no arms in this process's partition")
     bus = Bus(bus_config(cfg))
     node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
-                       stale_s=float(cfg.stale_s))  # fmt: skip
+                       stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis)  # fmt: skip
     started = time.monotonic()
     last_report = started
     print(f"ros2 monitor: {len(arms)} arms on domain {cfg.domain_id} ({', '.join(arms[:5])}"

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -85,9 +86,10 @@ class MonitorNode:
         require_truth: bool = True,
         stale_s: float = 1.0,
         keep_diagnoses: bool = False,
+        on_diagnosis: Callable[[str, GraphSample, Any], None] | None = None,
     ) -> None:
         self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
-        self.keep_diagnoses = keep_diagnoses
+        self.keep_diagnoses, self.on_diagnosis = keep_diagnoses, on_diagnosis
         self.factory = MessageFactory(IdlStore())
         self.arms: dict[str, ArmState] = {}
         self.diagnosis_writers: dict[str, Any] = {}
@@ -122,19 +124,31 @@ class MonitorNode:
                     for sample in got.samples:
                         submitted.append((arm, sample))
                         state.last_sample_wall = now
+        # One sample per arm per runtime step: every sample gets its own decision (a step given
+        # several samples of one stream decides only the last), and the arms share each step.
+        by_arm: dict[str, list[GraphSample]] = {}
         for arm, sample in submitted:
-            invalid = self.runtime.submit(arm, sample)
-            if invalid is not None:
-                self._record(arm, invalid)
-        for d in self.runtime.tick():
-            self._record(d.stream_id, d)
+            by_arm.setdefault(arm, []).append(sample)
+        for round_ in range(max((len(v) for v in by_arm.values()), default=0)):
+            queued = {}
+            for arm, samples in by_arm.items():
+                if round_ < len(samples):
+                    invalid = self.runtime.submit(arm, samples[round_])
+                    if invalid is not None:
+                        self._record(arm, invalid, samples[round_])
+                    else:
+                        queued[arm] = samples[round_]
+            for d in self.runtime.tick():
+                self._record(d.stream_id, d, queued[d.stream_id])
         return len(submitted)
 
-    def _record(self, arm: str, d: Any) -> None:
+    def _record(self, arm: str, d: Any, sample: GraphSample) -> None:
         state = self.arms[arm]
         state.last_diagnosis, state.samples = d, state.samples + 1
         if self.keep_diagnoses:
             state.diagnoses.append(d)
+        if self.on_diagnosis is not None:
+            self.on_diagnosis(arm, sample, d)
         fleet = self.runtime.fleet
         self.diagnosis_writers[arm].write(
             self.factory.health_diagnosis(d, fleet.classes, fleet.joints)
