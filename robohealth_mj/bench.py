@@ -8,6 +8,7 @@
     python -m robohealth_mj.bench infer --model results/headline_physics/<model>.onnx
     python -m robohealth_mj.bench streams [--model M] [--streams 1000] [--seconds 30]
     python -m robohealth_mj.bench soak [--model M] [--streams 1000] [--seconds 60]
+    python -m robohealth_mj.bench ros2 --model M [--arms 10 25 50] [--seconds 20]
 
 ``sim`` measures, in one run, the raw ``mj_step`` rate of the scene and the recorder's throughput
 (physics + control + sensor synthesis + JSONL writing), and reports their ratio. ``train
@@ -56,6 +57,11 @@ def main(argv: list[str] | None = None) -> None:
     headline = "results/headline_physics/anomaly_residual_w32_seed42.onnx"
     streams = sub.add_parser("streams", help="fleet load test: sustained 20 Hz streams")
     soak = sub.add_parser("soak", help="fleet under bad input: flags, tick budget, memory")
+    ros2 = sub.add_parser("ros2", help="arms per monitor over DDS on loopback, end-to-end latency")
+    ros2.add_argument("--model", required=True, help="an exported model.onnx")
+    ros2.add_argument("--data", default="outputs/corpus/quick/heldout_seed900")
+    ros2.add_argument("--arms", type=int, nargs="+", default=[10, 25, 50])
+    ros2.add_argument("--seconds", type=float, default=20.0)
     for p, seconds in ((streams, 30.0), (soak, 60.0)):
         p.add_argument("--model", default=headline)
         p.add_argument("--data", nargs="+", default=["outputs/corpus/standard/heldout_seed900"])
@@ -76,7 +82,11 @@ def main(argv: list[str] | None = None) -> None:
         help="alternated rounds of the with/without-memory comparison",
     )
     args = parser.parse_args(argv)
-    if args.what in ("streams", "soak"):
+    if args.what == "ros2":
+        from robohealth_mj.benchmarks.ros2 import bench_ros2
+
+        bench_ros2(args.model, args.data, args.arms, args.seconds)
+    elif args.what in ("streams", "soak"):
         from robohealth_mj.benchmarks.fleet import bench_fleet, bench_soak
 
         (bench_fleet if args.what == "streams" else bench_soak)(args)

@@ -58,6 +58,12 @@ class ArmPublisher:
         for topic, msg in self.factory.sample_messages(sample, self.topics):
             self.writers[topic].write(msg)
 
+    def publish_built(self, messages: list[Any]) -> None:
+        """Messages already built for one tick (in ``sample_topics`` order), shared by arms that
+        replay the same sample: the benchmark's publishers build once and write N times."""
+        for writer, msg in zip(self.writers.values(), messages, strict=True):
+            writer.write(msg)
+
 
 @dataclass
 class ArmState:
