@@ -219,3 +219,46 @@ def test_two_monitor_processes_split_four_arms_and_stop_cleanly_on_sigterm(deplo
     for result in live.values():
         for key in ("online_accuracy", "localisation_accuracy", "alarms", "false_alarm_rate"):
             assert result[key] == replay[key], key
+
+
+def test_a_topic_of_the_wrong_type_and_a_robot_that_goes_silent_and_returns_mark_their_arm(
+    deployed,
+):
+    """A writer of another message type on an arm's topic, an arm that stops and comes back:
+    each is that arm's status on /diagnostics (WARN, STALE, then OK again), the other arm's
+    diagnoses go on."""
+    from robohealth_mj.ros2.idl import Float64MultiArray
+
+    config = _bus()
+    robot, monitor_bus, stranger = Bus(config), Bus(config), Bus(config)
+    samples = list(itertools.islice(read_samples(deployed["heldout"]), 30))
+    node = MonitorNode(monitor_bus, ModelRuntime(deployed["structural_onnx"]), ["arm1", "arm2"],
+                       stale_s=0.4)  # fmt: skip
+    arms = {a: ArmPublisher(robot, a) for a in ("arm1", "arm2")}
+    stranger.writer("/arm2/joint_states", Float64MultiArray)  # the wrong type on arm2's topic
+    time.sleep(0.5)
+    for s in samples[:10]:
+        for pub in arms.values():
+            pub.publish(s)
+    _spin(node, lambda: node.arms["arm1"].samples >= 10 and node.arms["arm2"].samples >= 10)
+    status = {s.hardware_id: s for s in node.publish_diagnostics(samples[9].t).status}
+    assert (
+        status["arm2"].level == 1 and "cannot match a JointState reader" in status["arm2"].message
+    )
+    assert "bad input" not in status["arm1"].message
+    for s in samples[10:20]:  # arm2 goes silent
+        arms["arm1"].publish(s)
+    _spin(node, lambda: node.arms["arm1"].samples >= 20)
+    time.sleep(0.5)
+    node.poll()
+    arms["arm1"].publish(samples[20])
+    _spin(node, lambda: node.arms["arm1"].samples >= 21)
+    status = {s.hardware_id: s for s in node.publish_diagnostics(samples[20].t).status}
+    assert status["arm2"].level == 3 and status["arm1"].level != 3
+    for s in samples[21:30]:  # arm2 is back: its next stamps follow on
+        arms["arm2"].publish(s)
+    _spin(node, lambda: node.arms["arm2"].samples >= 19)
+    status = {s.hardware_id: s for s in node.publish_diagnostics(samples[29].t).status}
+    assert status["arm2"].level != 3 and node.arms["arm2"].samples == 19
+    for bus in (robot, monitor_bus, stranger):
+        bus.close()

@@ -91,6 +91,8 @@ class Bus:
         key = dds_topic(name)
         if key not in self._topics:
             self._topics[key] = Topic(self.participant, key, cls)
+        elif self._topics[key].data_type is not cls:
+            raise ValueError(f"topic {name!r} is {self._topics[key].data_type.__name__} here")
         return self._topics[key]
 
     def _qos(self, reliable: bool) -> Any:

@@ -182,7 +182,22 @@ class MonitorNode:
         msg.values.append(self.factory.KeyValue(key="problems", value=str(state.problems)))
         return msg
 
+    def check_writers(self) -> None:
+        """A writer on an arm's topic that cannot match (another message type, or a QoS the
+        reader cannot take) marks that arm: DDS reports it as a requested-incompatible QoS
+        (type consistency for a wrong type)."""
+        for state in self.arms.values():
+            for topic, kind, reader in state.readers:
+                status = reader.get_requested_incompatible_qos_status()
+                if status.total_count_change:
+                    state.problem = state.last_problem = (
+                        f"topic '{topic}': a writer that cannot match a {kind.__name__} reader "
+                        f"(wrong type or QoS; policy id {status.last_policy_id})"
+                    )
+                    state.problems += 1
+
     def publish_diagnostics(self, stamp: float) -> Any:
+        self.check_writers()
         now = time.monotonic()
         array = self.factory.DiagnosticArray(
             header=self.factory.header(stamp),
