@@ -37,7 +37,8 @@ from robohealth_mj.schema import (
 _STATE = {name: FEATURE_NAMES.index(name) for name in FEATURE_NAMES}
 _ACC = [_STATE[a] for a in ("acc_x", "acc_y", "acc_z")]
 _VIB = [_STATE[v] for v in VIBRATION_FIELDS]
-UNKNOWN = np.array([-1.0] + [0.0] * 8)  # REP 145: covariance[0] = -1 marks "not provided"
+UNKNOWN = np.array([-1.0] + [0.0] * 8)
+STAMP_LABEL = "stamp_ns="  # REP 145: covariance[0] = -1 marks "not provided"
 
 
 def typestore():
@@ -154,7 +155,12 @@ class MessageFactory:
                 ),
             ),
         ]
-        dim = [self.Dim(label=",".join(VIBRATION_FIELDS), size=len(VIBRATION_FIELDS), stride=1)]
+        # Float64MultiArray has no header: a second, empty dimension carries the sample's stamp
+        # (``stamp_ns=…``) so that a live reader pairs it with the other topics of its tick.
+        dim = [
+            self.Dim(label=",".join(VIBRATION_FIELDS), size=len(VIBRATION_FIELDS), stride=1),
+            self.Dim(label=f"{STAMP_LABEL}{stamp_ns(s.t)}", size=0, stride=0),
+        ]
         for j, joint in enumerate(JOINT_NAMES):
             row = x[N_JOINTS + j]
             acc = row[_ACC]
@@ -189,6 +195,17 @@ class MessageFactory:
         }
         level = self.Status.ERROR if f.active else self.Status.OK
         return self.diagnostics(s.t, level, "fault_state", message, s.recording_run_id, values)
+
+
+def array_stamp_ns(msg: Any) -> int | None:
+    """The stamp a vibration array carries in its layout (see ``sample_messages``), if any."""
+    for dim in getattr(getattr(msg, "layout", None), "dim", ()):
+        if dim.label.startswith(STAMP_LABEL):
+            try:
+                return int(dim.label[len(STAMP_LABEL) :])
+            except ValueError:
+                return None
+    return None
 
 
 def sample_from_messages(

@@ -1,8 +1,8 @@
 """One arm's GraphSamples from its topics as messages arrive, in any order across topics.
 
 Stamped topics (joint states, tracking error, each IMU, the ground truth) are keyed by their
-header stamp; a vibration array has no header, so each joint's arrays queue in arrival order (a
-writer's samples arrive in the order written) and the oldest goes with the oldest stamp. A stamp
+header stamp, a vibration array by the stamp its layout carries (``stamp_ns=``); an array without
+one (another publisher's) queues in arrival order and the oldest goes with the oldest stamp. A stamp
 is emitted once every topic has its message, in stamp order. What goes wrong on a live bus is
 returned as a problem for that arm, never raised: a stamp older than one already emitted, a stamp
 whose messages stopped coming while newer ones completed (``late_ticks``), a message that does
@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from robohealth_mj.bags.messages import sample_from_messages
+from robohealth_mj.bags.messages import array_stamp_ns, sample_from_messages
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.schema import FEATURE_NAMES, JOINT_NAMES, NODE_NAMES, FaultLabel, GraphSample
 
@@ -63,10 +63,10 @@ class ArmAssembler:
     def add(self, topic: str, msg: Any) -> Assembled:
         """Take one message; return the samples it completed and any problems."""
         out = Assembled()
-        if topic in self.queues:
+        if topic in self.queues and array_stamp_ns(msg) is None:
             self.queues[topic].append(msg)
         else:
-            stamp = _stamp_ns(msg)
+            stamp = _stamp_ns(msg) if topic not in self.queues else array_stamp_ns(msg)
             if stamp is None:
                 out.problems.append(f"topic '{topic}': message without a header stamp")
                 return out
@@ -90,7 +90,7 @@ class ArmAssembler:
         return all(t in slot for t in self.stamped)
 
     def _complete(self, slot: dict[str, Any]) -> bool:
-        return all(t in slot for t in self.stamped) and all(self.queues[t] for t in self.vibration)
+        return self._stamped_in(slot) and all(t in slot or self.queues[t] for t in self.vibration)
 
     def _drain(self, out: Assembled) -> None:
         while self.pending:
@@ -98,7 +98,7 @@ class ArmAssembler:
             slot = self.pending[oldest]
             if self._complete(slot):
                 del self.pending[oldest]
-                vibs = [self.queues[t].popleft() for t in self.vibration]
+                vibs = [slot[t] if t in slot else self.queues[t].popleft() for t in self.vibration]
                 self.last_emitted = oldest
                 try:
                     out.samples.append(self._sample(oldest, slot, vibs))
@@ -113,7 +113,7 @@ class ArmAssembler:
             if newer_complete < self.late_ticks:
                 return
             missing = [t for t in self.stamped if t not in slot] or [
-                t for t in self.vibration if not self.queues[t]
+                t for t in self.vibration if t not in slot and not self.queues[t]
             ]
             del self.pending[oldest]
             self.last_emitted = oldest
