@@ -8,6 +8,7 @@ from hydra.utils import instantiate
 
 from robohealth_mj import schema
 from robohealth_mj.config import compose_config
+from robohealth_mj.data.jsonl import node_features
 from robohealth_mj.data.sensing import SensingProfile
 
 J = schema.N_JOINTS
@@ -17,22 +18,26 @@ def _profile(name: str) -> SensingProfile:
     return instantiate(compose_config("train", [f"sensing={name}"]).sensing)
 
 
-def test_retrofit_zeroes_exactly_the_joint_channels_it_drops_and_nothing_on_sensors():
+def test_retrofit_zeroes_exactly_the_joint_channels_it_drops_and_no_sensor_channel():
+    """The dropped joint channels go on the joints and on the copies the schema puts on each
+    sensor node (else a sensor node would hand the model the motor current back); every sensor
+    channel and the kept joint channels pass untouched."""
     assert _profile("full").mask() is None
     mask = _profile("retrofit").mask()
     dropped = [schema.feature_index(n) for n in ("effort", "pos_error", "effort_residual")]
     expected = np.ones((schema.N_NODES, schema.N_FEATURES), np.float32)
-    expected[:J, dropped] = 0.0
+    expected[:, dropped] = 0.0
     np.testing.assert_array_equal(mask, expected)
-    x = np.random.default_rng(0).normal(size=(5, schema.N_NODES, schema.N_FEATURES))
-    x[:, :J, schema.SENSOR_CHANNELS] = 0.0
-    x[:, J:, schema.STATE_CHANNELS] = 0.0
+    rng = np.random.default_rng(0)
+    state = rng.normal(size=(5, J, len(schema.STATE_FEATURES)))
+    sensor = rng.normal(size=(5, J, len(schema.SENSOR_FEATURES)))
+    x = node_features(state, sensor)  # the recorder's layout: state on joints and sensors
     kept = x * mask
-    np.testing.assert_array_equal(kept[:, J:], x[:, J:])  # sensors untouched
+    np.testing.assert_array_equal(kept[..., schema.SENSOR_CHANNELS], x[..., schema.SENSOR_CHANNELS])
     for name in ("pos", "vel"):
         k = schema.feature_index(name)
-        np.testing.assert_array_equal(kept[:, :J, k], x[:, :J, k])
-    assert not kept[:, :J, dropped].any()
+        np.testing.assert_array_equal(kept[..., k], x[..., k])
+    assert not kept[..., dropped].any()
 
 
 def test_an_unknown_channel_is_refused_by_name():

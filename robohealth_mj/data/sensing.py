@@ -21,7 +21,9 @@ from robohealth_mj import schema
 
 @dataclass(frozen=True)
 class SensingProfile:
-    """The channels joint nodes and sensor nodes carry (the node-type flags always stay)."""
+    """The channels joint nodes and sensor nodes carry (the node-type flags always stay). A
+    sensor node repeats its joint's state channels (the schema), so ``joint_channels`` governs
+    those copies too: a channel the controller does not report is nowhere in the graph."""
 
     name: str
     joint_channels: Sequence[str] = schema.STATE_FEATURES
@@ -42,10 +44,9 @@ class SensingProfile:
         """``[12, F]`` of 1 (kept) and 0 (zeroed), or None when every channel is kept."""
         keep = np.zeros((schema.N_NODES, schema.N_FEATURES), np.float32)
         keep[:, :2] = 1.0  # is_joint, is_sensor
-        for name in self.joint_channels:
-            keep[: schema.N_JOINTS, schema.feature_index(name)] = 1.0
+        for name in self.joint_channels:  # on the joints and on their copies at the sensor nodes
+            keep[:, schema.feature_index(name)] = 1.0
         for name in self.sensor_channels:
             keep[schema.N_JOINTS :, schema.feature_index(name)] = 1.0
         keep[: schema.N_JOINTS, schema.SENSOR_CHANNELS] = 1.0  # zero there already
-        keep[schema.N_JOINTS :, schema.STATE_CHANNELS] = 1.0
         return None if keep.all() else keep
