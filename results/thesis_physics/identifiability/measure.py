@@ -23,7 +23,14 @@ def explained(x: np.ndarray) -> np.ndarray:
     r2 = np.zeros((6, 6))
     for j in range(6):
         design = np.column_stack(
-            [x[:, j, 2], x[:, j, 3], x[:, j, 4], x[:, j, 3] ** 2, np.abs(x[:, j, 4]), np.ones(len(x))]
+            [
+                x[:, j, 2],
+                x[:, j, 3],
+                x[:, j, 4],
+                x[:, j, 3] ** 2,
+                np.abs(x[:, j, 4]),
+                np.ones(len(x)),
+            ]
         )
         for k in range(6):
             scores = []
