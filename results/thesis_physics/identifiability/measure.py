@@ -11,6 +11,7 @@ from __future__ import annotations
 import glob
 import json
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -54,7 +55,7 @@ def main() -> None:
     print("| run | corr(C, C0) | per joint row |")
     print("|---|---|---|")
     for run in sys.argv[2:]:
-        summary = json.load(open(f"{run}/train_summary.json"))
+        summary = json.loads(Path(run, "train_summary.json").read_text())
         c, c0 = np.array(summary["coupling"]), np.array(summary["coupling_truth"])
         rows = [float(np.corrcoef(a, b)[0, 1]) for a, b in zip(c, c0, strict=True)]
         print(f"| {run} | {np.mean(rows):+.3f} | " + ", ".join(f"{v:+.2f}" for v in rows) + " |")
