@@ -62,6 +62,7 @@ def main(argv: list[str] | None = None) -> None:
     ros2.add_argument("--data", default="outputs/corpus/quick/heldout_seed900")
     ros2.add_argument("--arms", type=int, nargs="+", default=[10, 25, 50])
     ros2.add_argument("--seconds", type=float, default=20.0)
+    ros2.add_argument("--layouts", nargs="+", default=["per_sensor", "aggregated"])
     for p, seconds in ((streams, 30.0), (soak, 60.0)):
         p.add_argument("--model", default=headline)
         p.add_argument("--data", nargs="+", default=["outputs/corpus/standard/heldout_seed900"])
@@ -85,7 +86,7 @@ def main(argv: list[str] | None = None) -> None:
     if args.what == "ros2":
         from robohealth_mj.benchmarks.ros2 import bench_ros2
 
-        bench_ros2(args.model, args.data, args.arms, args.seconds)
+        bench_ros2(args.model, args.data, args.arms, args.seconds, args.layouts)
     elif args.what in ("streams", "soak"):
         from robohealth_mj.benchmarks.fleet import bench_fleet, bench_soak
 

@@ -275,3 +275,31 @@ def test_a_topic_of_the_wrong_type_and_a_robot_that_goes_silent_and_returns_mark
     assert status["arm2"].level != 3 and node.arms["arm2"].samples == 19
     for bus in (robot, monitor_bus, stranger):
         bus.close()
+
+
+def test_the_aggregated_layout_carries_each_snapshot_whole_over_the_bus(deployed):
+    """One array per arm per tick (and the truth): the samples arrive exactly, the diagnoses are
+    the per-sensor layout's."""
+    config = _bus()
+    robot, monitor_bus = Bus(config), Bus(config)
+    samples = list(itertools.islice(read_samples(deployed["heldout"]), 8))
+    node = MonitorNode(monitor_bus, ModelRuntime(deployed["structural_onnx"]), ["arm1"],
+                       layout="aggregated", keep_diagnoses=True)  # fmt: skip
+    pub = ArmPublisher(robot, "arm1", layout="aggregated")
+    assert list(pub.writers) == ["/arm1/graph_sample", "/arm1/fault_state"]
+    got = []
+    node.on_diagnosis = lambda arm, sample, d: got.append(sample)
+    time.sleep(0.5)
+    for s in samples:
+        pub.publish(s)
+    _spin(node, lambda: len(got) >= len(samples))
+    assert [s.sample_index for s in got] == [s.sample_index for s in samples]
+    for a, b in zip(got, samples, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        assert a.fault == b.fault
+    reference = ModelRuntime(deployed["structural_onnx"])
+    expected = [reference.process("arm1", s) for s in samples]
+    live = node.arms["arm1"].diagnoses
+    assert [d.fault_class for d in live] == [d.fault_class for d in expected]
+    for bus in (robot, monitor_bus):
+        bus.close()

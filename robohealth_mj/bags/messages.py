@@ -27,7 +27,10 @@ from robohealth_mj.data.jsonl import node_features
 from robohealth_mj.schema import (
     FEATURE_NAMES,
     JOINT_NAMES,
+    N_FEATURES,
     N_JOINTS,
+    N_NODES,
+    NODE_NAMES,
     SENSOR_CHANNELS,
     STATE_CHANNELS,
     FaultLabel,
@@ -180,6 +183,19 @@ class MessageFactory:
         out.append((topics.fault_state, self.fault_state(s)))
         return out
 
+    def aggregated(self, s: GraphSample) -> Any:
+        """The whole snapshot as one ``Float64MultiArray`` (the aggregated live layout): dims
+        nodes x features (labelled with their names) and the stamp dimension."""
+        layout = self.Layout(
+            dim=[
+                self.Dim(label=",".join(NODE_NAMES), size=N_NODES, stride=N_NODES * N_FEATURES),
+                self.Dim(label=",".join(FEATURE_NAMES), size=N_FEATURES, stride=N_FEATURES),
+                self.Dim(label=f"{STAMP_LABEL}{stamp_ns(s.t)}", size=0, stride=0),
+            ],
+            data_offset=0,
+        )
+        return self.Array(layout=layout, data=s.x.astype(np.float64).ravel())
+
     def fault_state(self, s: GraphSample) -> Any:
         f = s.fault
         message = (
@@ -206,6 +222,37 @@ def array_stamp_ns(msg: Any) -> int | None:
             except ValueError:
                 return None
     return None
+
+
+def truth_from_status(fault: Any, where) -> tuple[FaultLabel, int, dict, str]:
+    """``fault_state``'s label, sample index, segment and run id."""
+    if len(fault.status) != 1:
+        raise where("fault_state", f"field 'status': {len(fault.status)} entries, not 1")
+    status = fault.status[0]
+    values = {kv.key: kv.value for kv in status.values}
+    try:
+        label = FaultLabel(
+            values["class"],
+            values["joint"] or None,
+            float(values["severity"]),
+            values["active"] == "true",
+        )
+        index = int(values["sample_index"])
+        segment = json.loads(values["segment"])
+    except (KeyError, ValueError) as exc:
+        raise where("fault_state", f"field 'values': {type(exc).__name__}: {exc}") from None
+    return label, index, segment, status.hardware_id
+
+
+def sample_from_aggregated(t: float, array: Any, fault: Any, where) -> GraphSample:
+    """One GraphSample from the aggregated layout's array and its ``fault_state``."""
+    if len(array.data) != N_NODES * N_FEATURES:
+        raise where(
+            "aggregated", f"field 'data': {len(array.data)} values, not {N_NODES * N_FEATURES}"
+        )
+    x = np.asarray(array.data, np.float64).reshape(N_NODES, N_FEATURES).astype(np.float32)
+    label, index, segment, run_id = truth_from_status(fault, where)
+    return GraphSample(run_id, index, t, x, label, segment)
 
 
 def sample_from_messages(
@@ -235,19 +282,5 @@ def sample_from_messages(
             raise where(("vibration", j), f"field 'data': {len(vib.data)} values, not 5")
         sensor[j, vib_at] = vib.data
     x = node_features(joint_state, sensor).astype(np.float32)
-    if len(fault.status) != 1:
-        raise where("fault_state", f"field 'status': {len(fault.status)} entries, not 1")
-    status = fault.status[0]
-    values = {kv.key: kv.value for kv in status.values}
-    try:
-        label = FaultLabel(
-            values["class"],
-            values["joint"] or None,
-            float(values["severity"]),
-            values["active"] == "true",
-        )
-        index = int(values["sample_index"])
-        segment = json.loads(values["segment"])
-    except (KeyError, ValueError) as exc:
-        raise where("fault_state", f"field 'values': {type(exc).__name__}: {exc}") from None
-    return GraphSample(status.hardware_id, index, t, x, label, segment)
+    label, index, segment, run_id = truth_from_status(fault, where)
+    return GraphSample(run_id, index, t, x, label, segment)

@@ -24,6 +24,7 @@ class BagTopics:
     vibration: str = "/sensors/{joint}/vibration"
     fault_state: str = "/fault_state"
     health_diagnosis: str = "/health_diagnosis"
+    aggregated: str = "/graph_sample"
 
     @classmethod
     def load(cls, **overrides: str) -> BagTopics:
@@ -40,3 +41,7 @@ class BagTopics:
             out[self.vibration.format(joint=joint)] = ARRAY
         out[self.fault_state] = DIAGNOSTICS
         return out
+
+    def aggregated_topics(self) -> dict[str, str]:
+        """The aggregated live layout: the whole snapshot in one array, and the ground truth."""
+        return {self.aggregated: ARRAY, self.fault_state: DIAGNOSTICS}

@@ -15,17 +15,17 @@ from typing import Any
 import numpy as np
 
 
-def _publisher(domain: int, arms: int, samples: list, seconds: float, ready, go, out) -> None:
+def _publisher(
+    domain: int, arms: int, samples: list, seconds: float, layout: str, ready, go, out
+) -> None:
     from robohealth_mj.ros2.bus import Bus, BusConfig
     from robohealth_mj.ros2.node import ArmPublisher
 
     bus = Bus(BusConfig(domain_id=domain, interface="127.0.0.1", depth=50))
-    from robohealth_mj.bags.messages import MessageFactory
     from robohealth_mj.bags.topics import BagTopics
-    from robohealth_mj.ros2.idl import IdlStore
 
-    pubs = [ArmPublisher(bus, f"arm{k + 1}") for k in range(arms)]
-    factory, topics = MessageFactory(IdlStore()), BagTopics.load()
+    pubs = [ArmPublisher(bus, f"arm{k + 1}", layout=layout) for k in range(arms)]
+    topics = BagTopics.load()
     ready.set()
     go.wait()
     cpu0, wall0 = time.process_time(), time.perf_counter()
@@ -37,7 +37,7 @@ def _publisher(domain: int, arms: int, samples: list, seconds: float, ready, go,
             time.sleep(delay)
         base = samples[tick % len(samples)]
         sample = base.__class__("bench", tick, time.time(), base.x, base.fault, base.segment)
-        built = [m for _, m in factory.sample_messages(sample, topics)]  # stamped now
+        built = [m for _, m in pubs[0].messages(sample, topics)]  # stamped now
         for pub in pubs:
             pub.publish_built(built)
     out.put(
@@ -50,14 +50,18 @@ def _publisher(domain: int, arms: int, samples: list, seconds: float, ready, go,
     time.sleep(1.0)
 
 
-def run_once(model: str, samples: list, arms: int, seconds: float, domain: int) -> dict[str, Any]:
+def run_once(
+    model: str, samples: list, arms: int, seconds: float, domain: int, layout: str
+) -> dict[str, Any]:
     from robohealth_mj.ros2.bus import Bus, BusConfig
     from robohealth_mj.ros2.node import MonitorNode
     from robohealth_mj.runtime.runtime import ModelRuntime
 
     ctx = mp.get_context("spawn")
     ready, go, out = ctx.Event(), ctx.Event(), ctx.Queue()
-    child = ctx.Process(target=_publisher, args=(domain, arms, samples, seconds, ready, go, out))
+    child = ctx.Process(
+        target=_publisher, args=(domain, arms, samples, seconds, layout, ready, go, out)
+    )
     child.start()
     latencies: list[float] = []
 
@@ -65,8 +69,9 @@ def run_once(model: str, samples: list, arms: int, seconds: float, domain: int) 
         latencies.append(time.time() - sample.t)
 
     bus = Bus(BusConfig(domain_id=domain, interface="127.0.0.1", depth=50))
+    arm_names = [f"arm{k + 1}" for k in range(arms)]
     node = MonitorNode(
-        bus, ModelRuntime(model), [f"arm{k + 1}" for k in range(arms)], on_diagnosis=on_diagnosis
+        bus, ModelRuntime(model), arm_names, on_diagnosis=on_diagnosis, layout=layout
     )
     ready.wait(60)
     time.sleep(1.5)  # discovery
@@ -76,7 +81,7 @@ def run_once(model: str, samples: list, arms: int, seconds: float, domain: int) 
     expected = int(seconds * 20) * arms
     while time.perf_counter() < deadline and sum(s.samples for s in node.arms.values()) < expected:
         if not node.poll():
-            time.sleep(0.001)
+            time.sleep(0.005)  # as the monitor's default poll_s
     wall = time.perf_counter() - wall0
     cpu = time.process_time() - cpu0
     published = out.get(timeout=30)
@@ -87,7 +92,7 @@ def run_once(model: str, samples: list, arms: int, seconds: float, domain: int) 
     lat = np.array(latencies) * 1e3 if latencies else np.array([np.nan])
     return {
         "arms": arms,
-        "messages_per_s": arms * 15 * 20,
+        "messages_per_s": arms * (15 if layout == "per_sensor" else 2) * 20,
         "published_samples": published["ticks"] * arms,
         "diagnosed": got,
         "lost": published["ticks"] * arms - got,
@@ -100,7 +105,9 @@ def run_once(model: str, samples: list, arms: int, seconds: float, domain: int) 
     }
 
 
-def bench_ros2(model: str, data: str, arms_list: list[int], seconds: float) -> list[dict]:
+def bench_ros2(
+    model: str, data: str, arms_list: list[int], seconds: float, layouts: list[str]
+) -> list[dict]:
     from robohealth_mj.data.arrays import resolve_recordings
     from robohealth_mj.data.read import read_samples
 
@@ -108,15 +115,16 @@ def bench_ros2(model: str, data: str, arms_list: list[int], seconds: float) -> l
     domains = itertools.count(150)
     rows = []
     print(
-        f"{'arms':>5} {'msg/s':>7} {'lost':>6} {'bad':>4} {'p50 ms':>7} {'p99 ms':>7} "
-        f"{'monitor CPU':>11} {'publisher CPU':>13}"
+        f"{'layout':>10} {'arms':>5} {'msg/s':>7} {'lost':>6} {'bad':>4} {'p50 ms':>7} "
+        f"{'p99 ms':>7} {'monitor CPU':>11} {'publisher CPU':>13}"
     )
-    for arms in arms_list:
-        r = run_once(model, samples, arms, seconds, next(domains))
+    for layout, arms in itertools.product(layouts, arms_list):
+        r = run_once(model, samples, arms, seconds, next(domains), layout)
+        r["layout"] = layout
         rows.append(r)
         print(
-            f"{r['arms']:>5} {r['messages_per_s']:>7} {r['lost']:>6} {r['problems']:>4} "
-            f"{r['latency_p50_ms']:>7.1f} {r['latency_p99_ms']:>7.1f} "
+            f"{layout:>10} {r['arms']:>5} {r['messages_per_s']:>7} {r['lost']:>6} "
+            f"{r['problems']:>4} {r['latency_p50_ms']:>7.1f} {r['latency_p99_ms']:>7.1f} "
             f"{r['monitor_cpu_cores']:>10.2f}c {r['publisher_cpu_cores']:>12.2f}c",
             flush=True,
         )

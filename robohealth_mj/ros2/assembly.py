@@ -17,7 +17,11 @@ from typing import Any
 
 import numpy as np
 
-from robohealth_mj.bags.messages import array_stamp_ns, sample_from_messages
+from robohealth_mj.bags.messages import (
+    array_stamp_ns,
+    sample_from_aggregated,
+    sample_from_messages,
+)
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.schema import FEATURE_NAMES, JOINT_NAMES, NODE_NAMES, FaultLabel, GraphSample
 
@@ -43,13 +47,21 @@ class ArmAssembler:
     """Assembles one arm's samples; ``topics`` are that arm's (namespaced) topic names."""
 
     def __init__(
-        self, arm: str, topics: BagTopics, require_truth: bool = True, late_ticks: int = 10
+        self,
+        arm: str,
+        topics: BagTopics,
+        require_truth: bool = True,
+        late_ticks: int = 10,
+        aggregated: str | None = None,
     ) -> None:
-        self.arm, self.topics = arm, topics
+        self.arm, self.topics, self.aggregated = arm, topics, aggregated
         self.require_truth, self.late_ticks = require_truth, late_ticks
-        self.vibration = [topics.vibration.format(joint=j) for j in JOINT_NAMES]
-        self.imu = [topics.imu.format(joint=j) for j in JOINT_NAMES]
-        self.stamped = [topics.joint_states, topics.joint_errors, *self.imu]
+        if aggregated:  # one array per tick carries the whole snapshot
+            self.vibration, self.imu, self.stamped = [], [], [aggregated]
+        else:
+            self.vibration = [topics.vibration.format(joint=j) for j in JOINT_NAMES]
+            self.imu = [topics.imu.format(joint=j) for j in JOINT_NAMES]
+            self.stamped = [topics.joint_states, topics.joint_errors, *self.imu]
         if require_truth:
             self.stamped.append(topics.fault_state)
         self.pending: dict[int, dict[str, Any]] = {}
@@ -66,7 +78,8 @@ class ArmAssembler:
         if topic in self.queues and array_stamp_ns(msg) is None:
             self.queues[topic].append(msg)
         else:
-            stamp = _stamp_ns(msg) if topic not in self.queues else array_stamp_ns(msg)
+            headerless = topic in self.queues or topic == self.aggregated
+            stamp = array_stamp_ns(msg) if headerless else _stamp_ns(msg)
             if stamp is None:
                 out.problems.append(f"topic '{topic}': message without a header stamp")
                 return out
@@ -126,20 +139,29 @@ class ArmAssembler:
         at = f"at stamp {stamp / 1e9:.6f} s"
 
         def where(key, message: str) -> _Problem:
-            topic = getattr(self.topics, key) if isinstance(key, str) else self.vibration[key[1]]
+            if key == "aggregated":
+                topic = self.aggregated
+            else:
+                topic = (
+                    getattr(self.topics, key) if isinstance(key, str) else self.vibration[key[1]]
+                )
             return _Problem(f"topic '{topic}' {at}: {message}")
 
         truth = slot.get(self.topics.fault_state) if self.require_truth else None
+        truth = truth if truth is not None else _NoTruth(self.arm, self.count)
         try:
-            sample = sample_from_messages(
-                stamp / 1e9,
-                slot[self.topics.joint_states],
-                slot[self.topics.joint_errors],
-                [slot[t] for t in self.imu],
-                vibs,
-                truth if truth is not None else _NoTruth(self.arm, self.count),
-                where,
-            )
+            if self.aggregated:
+                sample = sample_from_aggregated(stamp / 1e9, slot[self.aggregated], truth, where)
+            else:
+                sample = sample_from_messages(
+                    stamp / 1e9,
+                    slot[self.topics.joint_states],
+                    slot[self.topics.joint_errors],
+                    [slot[t] for t in self.imu],
+                    vibs,
+                    truth,
+                    where,
+                )
         except (AttributeError, TypeError, ValueError) as exc:
             raise _Problem(f"{at}: malformed message ({exc})") from None
         bad = np.argwhere(~np.isfinite(sample.x))

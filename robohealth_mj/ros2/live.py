@@ -68,7 +68,8 @@ def run_monitor(
         raise ValueError("ros2: no arms in this process's partition")
     bus = Bus(bus_config(cfg))
     node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
-                       stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis)  # fmt: skip
+                       stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
+                       layout=str(cfg.layout))  # fmt: skip
     started = time.monotonic()
     last_report = started
     print(f"ros2 monitor: {len(arms)} arms on domain {cfg.domain_id} ({', '.join(arms[:5])}"
@@ -79,8 +80,8 @@ def run_monitor(
                 now = time.monotonic()
                 if duration_s and now - started >= duration_s:
                     break
-                if not node.poll():
-                    time.sleep(0.002)
+                if not node.poll():  # nothing completed: wait a poll period (an empty poll of
+                    time.sleep(float(cfg.poll_s))  # every reader is not free)
                 if now - last_report >= float(cfg.diagnostics_period_s):
                     node.publish_diagnostics(time.time())
                     last_report = now
@@ -101,7 +102,7 @@ def run_robot(cfg: DictConfig, stream: Iterator[tuple[float, GraphSample]]) -> i
     from robohealth_mj.ros2.node import ArmPublisher
 
     bus = Bus(bus_config(cfg.ros2))
-    arms = [ArmPublisher(bus, arm) for arm in arm_names(cfg.ros2)]
+    arms = [ArmPublisher(bus, arm, layout=str(cfg.ros2.layout)) for arm in arm_names(cfg.ros2)]
     time.sleep(float(cfg.discovery_s))  # let subscribers match before the first sample
     ticks, started, t0 = 0, time.perf_counter(), None
     with stop_on_signals() as stop:

@@ -43,19 +43,42 @@ def in_partition(arm: str, partition: str | None) -> bool:
     return zlib.crc32(arm.encode()) % n == k
 
 
+LAYOUTS = ("per_sensor", "aggregated")
+
+
+def layout_topics(topics: BagTopics, layout: str) -> dict[str, str]:
+    """The topics (-> message type) one sample travels on in ``layout``: ``per_sensor`` (the bag
+    layout, 15 messages a tick) or ``aggregated`` (the snapshot in one array, and the truth)."""
+    if layout not in LAYOUTS:
+        raise ValueError(f"ros2.layout must be one of {LAYOUTS}, got {layout!r}")
+    return topics.sample_topics() if layout == "per_sensor" else topics.aggregated_topics()
+
+
 class ArmPublisher:
     """One simulated or replayed arm publishing its samples as a robot driver would."""
 
-    def __init__(self, bus: Bus, arm: str, topics: BagTopics | None = None) -> None:
-        self.arm, self.topics = arm, arm_topics(arm, topics)
+    def __init__(
+        self, bus: Bus, arm: str, topics: BagTopics | None = None, layout: str = "per_sensor"
+    ) -> None:
+        self.arm, self.topics, self.layout = arm, arm_topics(arm, topics), layout
         self.factory = MessageFactory(IdlStore())
         self.writers = {
             name: bus.writer(name, TYPES[kind])
-            for name, kind in self.topics.sample_topics().items()
+            for name, kind in layout_topics(self.topics, layout).items()
         }
 
+    def messages(self, sample: GraphSample, topics: BagTopics | None = None) -> list[tuple]:
+        """``(topic, message)`` of one sample in this arm's layout (``topics``: other names)."""
+        topics = topics or self.topics
+        if self.layout == "aggregated":
+            return [
+                (topics.aggregated, self.factory.aggregated(sample)),
+                (topics.fault_state, self.factory.fault_state(sample)),
+            ]
+        return self.factory.sample_messages(sample, topics)
+
     def publish(self, sample: GraphSample) -> None:
-        for topic, msg in self.factory.sample_messages(sample, self.topics):
+        for topic, msg in self.messages(sample):
             self.writers[topic].write(msg)
 
     def publish_built(self, messages: list[Any]) -> None:
@@ -93,6 +116,7 @@ class MonitorNode:
         stale_s: float = 1.0,
         keep_diagnoses: bool = False,
         on_diagnosis: Callable[[str, GraphSample, Any], None] | None = None,
+        layout: str = "per_sensor",
     ) -> None:
         self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
         self.keep_diagnoses, self.on_diagnosis = keep_diagnoses, on_diagnosis
@@ -101,8 +125,9 @@ class MonitorNode:
         self.diagnosis_writers: dict[str, Any] = {}
         for arm in arms:
             names = arm_topics(arm, topics)
-            assembler = ArmAssembler(arm, names, require_truth=require_truth)
-            kinds = names.sample_topics()
+            kinds = layout_topics(names, layout)
+            aggregated = names.aggregated if layout == "aggregated" else None
+            assembler = ArmAssembler(arm, names, require_truth=require_truth, aggregated=aggregated)
             readers = [
                 (t, TYPES[kinds[t]], bus.reader(t, TYPES[kinds[t]]))
                 for t in assembler.topic_names()
