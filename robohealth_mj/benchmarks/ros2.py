@@ -102,6 +102,7 @@ def run_once(
         "monitor_cpu_cores": cpu / wall,
         "publisher_cpu_cores": published["cpu_cores"],
         "publisher_late_s": published["late_s"],
+        "monitor_seconds": {k: v / wall for k, v in node.seconds.items()},  # cores per phase
     }
 
 
@@ -116,7 +117,7 @@ def bench_ros2(
     rows = []
     print(
         f"{'layout':>10} {'arms':>5} {'msg/s':>7} {'lost':>6} {'bad':>4} {'p50 ms':>7} "
-        f"{'p99 ms':>7} {'monitor CPU':>11} {'publisher CPU':>13}"
+        f"{'p99 ms':>7} {'monitor CPU':>11} {'publisher CPU':>13}   monitor time by phase"
     )
     for layout, arms in itertools.product(layouts, arms_list):
         r = run_once(model, samples, arms, seconds, next(domains), layout)
@@ -125,7 +126,8 @@ def bench_ros2(
         print(
             f"{layout:>10} {r['arms']:>5} {r['messages_per_s']:>7} {r['lost']:>6} "
             f"{r['problems']:>4} {r['latency_p50_ms']:>7.1f} {r['latency_p99_ms']:>7.1f} "
-            f"{r['monitor_cpu_cores']:>10.2f}c {r['publisher_cpu_cores']:>12.2f}c",
+            f"{r['monitor_cpu_cores']:>10.2f}c {r['publisher_cpu_cores']:>12.2f}c   "
+            + "  ".join(f"{k} {v:.2f}c" for k, v in r["monitor_seconds"].items()),
             flush=True,
         )
     return rows
