@@ -10,7 +10,7 @@ from omegaconf import OmegaConf
 
 from robohealth_mj.config import compose_config
 from robohealth_mj.corpus import build_corpus, plan
-from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.data.read import read_samples
 from robohealth_mj.dataset import main as dataset_main
 from robohealth_mj.recorder import GRAPHS_FILE, record_session
 from robohealth_mj.schema import SCHEMA_VERSION

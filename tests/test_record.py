@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from robohealth_mj import schema
-from robohealth_mj.data.jsonl import read_samples
+from robohealth_mj.data.read import read_samples
 from robohealth_mj.recorder import GRAPHS_FILE, MANIFEST_FILE, record_session
 
 REPO = Path(__file__).resolve().parents[1]

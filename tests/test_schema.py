@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from robohealth_mj import schema
-from robohealth_mj.data.jsonl import format_line, node_features, read_samples
+from robohealth_mj.data.jsonl import format_line, node_features
+from robohealth_mj.data.read import read_samples
 from robohealth_mj.schema import FaultLabel, SchemaError, validate_sample
 
 
