@@ -347,12 +347,12 @@ def cost_markdown(rows: list[dict[str, Any]], root: Path) -> str:
 
 def markdown(rows: list[dict[str, Any]]) -> str:
     """Tables 6, 7 and 8, then every other setting in Table 6's layout."""
-    parts = [table6(rows), table7(rows), table8(rows)]
+    parts = [t for t in (table6(rows), table7(rows), table8(rows)) if t]
     others = [r for r in rows if r["setting"] != REFERENCE and r["graph"] == "structural"]
     for setting in dict.fromkeys(r["setting"] for r in others):
         parts += [f"### {setting}", "", _MAIN_HEAD, "|---|---|---|---|---|---|---|---|---|---|---|"]
         parts += [_main_row(r) for r in others if r["setting"] == setting] + [""]
-    return "\n".join(p for p in parts if p)
+    return "\n".join(parts)
 
 
 def write_csv(rows: list[dict[str, Any]]) -> str:
