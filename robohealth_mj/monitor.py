@@ -27,6 +27,8 @@ from robohealth_mj.bags import is_bag
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.bags.writer import BagWriter
 from robohealth_mj.config import load_cli_config
+from robohealth_mj.data.read import recording_sensing
+from robohealth_mj.data.sensing import refuse_missing_channels
 from robohealth_mj.errors import InputError, one_line_errors
 from robohealth_mj.reporting.online import online_markdown
 from robohealth_mj.runtime.alarms import AlarmPolicy
@@ -90,9 +92,12 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
     elif cfg.source == "replay":
         if not cfg.file or not (Path(cfg.file).is_file() or is_bag(cfg.file)):
             raise FileNotFoundError(
-                f"source=replay needs file=PATH to a graphs.jsonl or a bag directory "
-                f"(got {cfg.file})"
+                f"source=replay needs file=PATH to a graphs.jsonl, a bag directory or a "
+                f"controller log (.csv, .parquet) (got {cfg.file})"
             )
+        if cfg.model:
+            model_sensing = read_metadata(cfg.model).get("sensing", "full")
+            refuse_missing_channels(model_sensing, recording_sensing(cfg.file), cfg.file)
         stream = replay_stream(cfg.file)
     else:
         raise InputError(f"source must be sim, replay or ros2, got {cfg.source!r}")

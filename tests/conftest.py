@@ -163,3 +163,35 @@ def deployed(tmp_path_factory, learnable_corpus) -> dict[str, Path]:
         tmp_path_factory, "deploy", lambda root: _train_and_export(learnable_corpus, root)
     )
     return {key: Path(value) for key, value in paths.items()}
+
+
+def _train_stock(corpus: Path, root: Path) -> dict:
+    from robohealth_mj.runtime.export import export_checkpoint
+    from robohealth_mj.train import run
+
+    cfg = compose_config(
+        "train",
+        [
+            f"data.train=[{corpus}/train_*]",
+            f"data.evaluate.heldout={corpus}/heldout",
+            "data.evaluate.probe=null",
+            "trainer.progress=false",
+            "trainer.epochs=1",
+            "window=8",
+            "sensing=stock",
+            "variant=stgnn_fixed",
+            "model.hidden=8",
+        ],
+    )
+    run(cfg, root / "run")
+    onnx = export_checkpoint(root / "run" / "best.ckpt", root / "model.onnx")["path"]
+    return {"ckpt": str(root / "run" / "best.ckpt"), "onnx": onnx,
+            "heldout": str(corpus / "heldout" / "graphs.jsonl")}  # fmt: skip
+
+
+@pytest.fixture(scope="session")
+def stock_deployed(tmp_path_factory, tiny_corpus) -> dict[str, Path]:
+    """A ``stgnn_fixed`` trained (1 epoch) with ``sensing=stock`` and exported, and its
+    held-out data (``tiny_corpus``, which has every fault class)."""
+    paths = cached(tmp_path_factory, "stock", lambda root: _train_stock(tiny_corpus, root))
+    return {key: Path(value) for key, value in paths.items()}

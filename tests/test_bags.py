@@ -433,3 +433,29 @@ def test_every_bad_file_gets_one_line_and_exit_status_2(deployed, bad_files, key
         f=bad_files[key], heldout=deployed["heldout"], ckpt=deployed["structural_ckpt"]
     ).split()
     _one_line_error(_python(f"robohealth_mj.{args[0]}", *args[1:]), *needles)
+
+
+def test_a_robots_own_bag_without_truth_or_sensors_is_numbered_by_stamp(deployed, tmp_path):
+    """A bag of only the joint state and tracking error (a stock arm's, no /fault_state): samples
+    numbered by stamp (a lost stamp is a gap), read as healthy, sensor channels zero, and the
+    bag's profile is stock, which a full model refuses in one line."""
+    from robohealth_mj.data.read import recording_sensing
+    from robohealth_mj.learn.evaluation import evaluate_checkpoint
+
+    samples = list(read_samples(deployed["heldout"]))[:30]
+    topics = BagTopics.load()
+    keep = {topics.joint_states, topics.joint_errors}
+    out = tmp_path / "robot_bag"
+    _write_edited(samples, out, lambda topic, k, raw: raw if topic in keep and k != 12 else None)
+    got = list(read_samples(out))
+    assert [s.sample_index for s in got] == [k for k in range(30) if k != 12]
+    assert {s.recording_run_id for s in got} == {"robot_bag"}
+    assert all(s.fault == schema.FaultLabel() for s in got)
+    for s, source in zip(got, [s for k, s in enumerate(samples) if k != 12], strict=True):
+        np.testing.assert_allclose(
+            s.x[:, schema.STATE_CHANNELS], source.x[:, schema.STATE_CHANNELS], atol=1e-6
+        )
+        assert not s.x[:, schema.SENSOR_CHANNELS].any()
+    assert recording_sensing(out) == "stock" and recording_sensing(deployed["heldout"]) == "full"
+    with pytest.raises(ValueError, match="robot_bag: the data has the stock profile's channels"):
+        evaluate_checkpoint(deployed["structural_ckpt"], [str(out)])

@@ -179,7 +179,9 @@ def test_bad_graph_is_a_clear_error():
     with pytest.raises(ValueError, match="square"):
         _build("stgnn_fixed", adjacency=np.zeros((12, 11)))
     with pytest.raises(ValueError, match="num_joints"):
-        _build("stgnn_fixed", num_joints=12)
+        _build("stgnn_fixed", num_joints=13)
+    with pytest.raises(ValueError, match="no sensor nodes"):  # a graph of joints alone
+        _build("anomaly_residual", num_joints=12)
 
 
 @pytest.mark.parametrize("name", VARIANTS)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from hydra.utils import instantiate
@@ -94,3 +96,53 @@ def test_a_retrofit_model_never_reads_the_channels_its_arm_lacks(tiny_corpus, tm
     out, same, other = (session.run(None, {"x": v})[0] for v in (x, noisy, moved))
     np.testing.assert_allclose(out, same, atol=1e-5)
     assert not np.allclose(out, other, atol=1e-3)  # the channels it keeps still count
+
+
+def test_stock_reads_the_joints_alone_and_labels_sensor_faults_healthy(stock_deployed):
+    """The stock profile: a graph of the six joints, a label set without sensor faults (those
+    sessions are healthy on an arm without the sensor), trained, evaluated, exported and run in
+    the fleet runtime with outputs that no sensor channel can move."""
+    from robohealth_mj.data.arrays import load_recordings
+    from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
+    from robohealth_mj.learn.evaluation import evaluate_checkpoint
+    from robohealth_mj.runtime.export import read_metadata
+    from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
+
+    ckpt = stock_deployed["ckpt"]
+    graph = graph_from_checkpoint(load_checkpoint(ckpt))
+    assert graph.node_names == schema.JOINT_NAMES and graph.adjacency.shape == (J, J)
+    assert graph.classes == ("none", "backlash", "friction", "jam", "struct_weaken")
+    heldout = stock_deployed["heldout"]
+    rec = load_recordings([heldout])
+    sensor_faults = np.isin(rec.fault_class, [5, 6])
+    assert sensor_faults.any()  # the session has them; the stock label set does not
+    relabelled = graph.relabel(rec)
+    assert not np.isin(relabelled.fault_class, [5, 6]).any()
+    assert not relabelled.active[sensor_faults].any()
+    np.testing.assert_array_equal(
+        relabelled.fault_class[~sensor_faults], rec.fault_class[~sensor_faults]
+    )
+    per_class = evaluate_checkpoint(ckpt, [str(heldout)])["metrics"]["per_class"]
+    assert per_class["sensor_drift"]["support"] == per_class["sensor_noise"]["support"] == 0
+
+    onnx = str(stock_deployed["onnx"])
+    meta = read_metadata(onnx)
+    assert meta["sensing"] == "stock" and json.loads(meta["label_set"]) == list(graph.classes)
+    x = rec.x[:64].copy()
+    loud = x.copy()
+    loud[:, J:, schema.SENSOR_CHANNELS] += 50.0  # a sensor package the stock arm does not have
+    probs = []
+    for data in (x, loud):
+        fleet = FleetRuntime(onnx)
+        slot = fleet.register(["arm"])
+        for t in range(len(data)):
+            r = fleet.step(slot, np.array([t]), np.array([0.05 * (t + 1)]), data[t : t + 1])
+        assert r.status[0] == DECIDED
+        probs.append(r.probs[0])
+    np.testing.assert_allclose(probs[0], probs[1], atol=1e-5)
+
+
+def test_stock_on_the_harness_is_refused_in_one_line():
+    cfg = compose_config("train", ["sensing=stock", "graph=harness"])
+    with pytest.raises(ValueError, match="sensing=stock has no sensors"):
+        instantiate(cfg.graph).with_sensing(instantiate(cfg.sensing))

@@ -255,10 +255,22 @@ def sample_from_aggregated(t: float, array: Any, fault: Any, where) -> GraphSamp
     return GraphSample(run_id, index, t, x, label, segment)
 
 
+# The segment of a sample with no ground truth (a robot's own bag or log): nothing is known of it.
+UNLABELLED_SEGMENT = {"index": 0, "family": "log", "speed_scale": 1.0, "payload_scale": 1.0}
+
+
 def sample_from_messages(
-    t: float, state: Any, errors: Any, imus: list[Any], vibs: list[Any], fault: Any, where
+    t: float,
+    state: Any,
+    errors: Any,
+    imus: list[Any] | None,
+    vibs: list[Any] | None,
+    fault: Any | None,
+    where,
 ) -> GraphSample:
-    """Assemble one GraphSample; ``where(topic_key, message)`` makes the error for a bad field."""
+    """Assemble one GraphSample; ``where(topic_key, message)`` makes the error for a bad field.
+    Without the sensor messages the sensor channels stay zero; without ``fault`` the sample is
+    healthy, numbered 0 (the reader numbers such samples by stamp)."""
     for key, msg in (("joint_states", state), ("joint_errors", errors)):
         if list(msg.name) != list(JOINT_NAMES):
             raise where(key, f"field 'name': {list(msg.name)} is not {list(JOINT_NAMES)}")
@@ -275,12 +287,14 @@ def sample_from_messages(
     sensor = np.zeros((N_JOINTS, SENSOR_CHANNELS.stop - SENSOR_CHANNELS.start))
     vib_at = [FEATURE_NAMES.index(v) - SENSOR_CHANNELS.start for v in VIBRATION_FIELDS]
     acc_at = [FEATURE_NAMES.index(a) - SENSOR_CHANNELS.start for a in ("acc_x", "acc_y", "acc_z")]
-    for j, (imu, vib) in enumerate(zip(imus, vibs, strict=True)):
+    for j, (imu, vib) in enumerate(zip(imus or (), vibs or (), strict=True)):
         a = imu.linear_acceleration
         sensor[j, acc_at] = (a.x, a.y, a.z)
         if len(vib.data) != len(VIBRATION_FIELDS):
             raise where(("vibration", j), f"field 'data': {len(vib.data)} values, not 5")
         sensor[j, vib_at] = vib.data
     x = node_features(joint_state, sensor).astype(np.float32)
+    if fault is None:
+        return GraphSample("", 0, t, x, FaultLabel(), dict(UNLABELLED_SEGMENT))
     label, index, segment, run_id = truth_from_status(fault, where)
     return GraphSample(run_id, index, t, x, label, segment)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +53,18 @@ def _open(path: Path):
     return reader
 
 
+def bag_sensing(path: Path | str, topics: BagTopics | None = None) -> str:
+    """``stock`` for a bag with no sensor package topics (a robot's own), else ``full``."""
+    topics = topics or BagTopics.load()
+    reader = _open(Path(path))
+    try:
+        present = {c.topic for c in reader.connections}
+    finally:
+        reader.close()
+    sensors = {topics.imu.format(joint=j) for j in JOINT_NAMES}
+    return "full" if sensors & present else "stock"
+
+
 def bag_manifest(path: Path | str) -> dict | None:
     """The session manifest a bag carries in its custom metadata, if any."""
     import yaml
@@ -76,6 +89,8 @@ def read_bag_samples(path: Path | str, topics: BagTopics | None = None) -> Itera
     reader = _open(path)
     try:
         present = {c.topic: c.msgtype for c in reader.connections}
+        optional = optional_topics(topics, present)
+        wanted = {t: m for t, m in wanted.items() if t in present or t not in optional}
         for topic, msgtype in wanted.items():
             if topic not in present:
                 raise BagError(f"topic '{topic}' ({msgtype}) is missing", source=str(path))
@@ -109,9 +124,22 @@ def read_bag_samples(path: Path | str, topics: BagTopics | None = None) -> Itera
     yield from _assemble(path, topics, wanted, by_stamp)
 
 
+def optional_topics(topics: BagTopics, present) -> set[str]:
+    """What a bag may lack: the ground truth (a robot's own bag has none: its samples are
+    numbered by stamp and read as healthy) and the sensor package, all of it or none (a stock
+    arm has none: those channels stay zero)."""
+    sensors = {topics.imu.format(joint=j) for j in JOINT_NAMES}
+    sensors |= {topics.vibration.format(joint=j) for j in JOINT_NAMES}
+    return {topics.fault_state} | (sensors if not sensors & set(present) else set())
+
+
 def _assemble(path, topics: BagTopics, wanted, by_stamp) -> Iterator[GraphSample]:
     imu = [topics.imu.format(joint=j) for j in JOINT_NAMES]
     vib = [topics.vibration.format(joint=j) for j in JOINT_NAMES]
+    sensors = imu[0] in wanted
+    truth = topics.fault_state in wanted
+    stamps = sorted(by_stamp)
+    period = float(np.median(np.diff(stamps))) if len(stamps) > 1 else 1.0
     stray = [t for t in sorted(by_stamp) if topics.joint_states not in by_stamp[t]]
     if stray:  # before "missing": a late message is missing at one stamp and stray at another
         other = sorted(by_stamp[stray[0]])[0]
@@ -120,7 +148,7 @@ def _assemble(path, topics: BagTopics, wanted, by_stamp) -> Iterator[GraphSample
             "message at that stamp (late, early or stray)",
             source=str(path),
         )
-    for stamp in sorted(by_stamp):
+    for stamp in stamps:
         msgs = by_stamp[stamp]
         at = f"at stamp {stamp / 1e9:.6f} s"
         for topic in wanted:
@@ -140,11 +168,14 @@ def _assemble(path, topics: BagTopics, wanted, by_stamp) -> Iterator[GraphSample
                 stamp / 1e9,
                 msgs[topics.joint_states],
                 msgs[topics.joint_errors],
-                [msgs[t] for t in imu],
-                [msgs[t] for t in vib],
-                msgs[topics.fault_state],
+                [msgs[t] for t in imu] if sensors else None,
+                [msgs[t] for t in vib] if sensors else None,
+                msgs[topics.fault_state] if truth else None,
                 where,
             )
+            if not truth:  # numbered by stamp: a gap in the stamps is a gap in the numbering
+                index = round((stamp - stamps[0]) / period)
+                sample = replace(sample, recording_run_id=path.name, sample_index=index)
         except (AttributeError, TypeError, ValueError) as exc:
             if isinstance(exc, SchemaError):
                 raise

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.errors import InputError
 
 # Every joint reaches at least one sensor, and every joint's row is distinct, so the six joints
 # stay distinguishable from four sensors.
@@ -38,15 +39,49 @@ class GraphSpec:
     coupling: np.ndarray | None = None  # C0 [J, M] for the harness
     sensing: str = "full"  # the sensing profile (data/sensing.py) whose channels the graph keeps
     channel_mask: np.ndarray | None = None  # [12, F] 1 kept / 0 zeroed, on the schema's nodes
+    schema_nodes: int = schema.N_NODES  # the leading schema nodes read (6: the joints only)
+    classes: tuple[str, ...] = schema.FAULT_CLASSES  # the label set (the profile's)
 
     def with_sensing(self, profile) -> GraphSpec:
-        """This graph reading only the channels ``profile`` (a SensingProfile) names."""
-        return replace(self, sensing=profile.name, channel_mask=profile.mask())
+        """This graph reading only the channels ``profile`` (a SensingProfile) names; without
+        sensor channels, without the sensor nodes."""
+        spec = replace(
+            self, sensing=profile.name, channel_mask=profile.mask(), classes=profile.label_set
+        )
+        if profile.sensor_nodes:
+            return spec
+        if self.coupling is not None:
+            raise InputError(
+                f"sensing={profile.name} has no sensors, so there is no placement to learn: "
+                "use graph=structural"
+            )
+        j = self.num_joints
+        return replace(
+            spec, node_names=self.node_names[:j], adjacency=self.adjacency[:j, :j], schema_nodes=j
+        )
+
+    def relabel(self, rec):
+        """``rec`` (a Recording) with every class outside the label set read as healthy: a
+        sensor fault on an arm without that sensor leaves the arm healthy."""
+        if self.classes == schema.FAULT_CLASSES:
+            return rec
+        outside = ~np.isin(rec.fault_class, [schema.FAULT_CLASSES.index(c) for c in self.classes])
+        if not outside.any():
+            return rec
+        return replace(
+            rec,
+            fault_class=np.where(outside, 0, rec.fault_class),
+            fault_joint=np.where(outside, -1, rec.fault_joint),
+            severity=np.where(outside, 0.0, rec.severity).astype(np.float32),
+            active=rec.active & ~outside,
+        )
 
     def transform(self, x: np.ndarray) -> np.ndarray:
         """Schema snapshots ``[..., 12, F]`` -> this graph's node features ``[..., N, F]``."""
         if self.channel_mask is not None:
             x = (x * self.channel_mask).astype(np.float32)
+        if self.schema_nodes < x.shape[-2]:
+            x = np.ascontiguousarray(x[..., : self.schema_nodes, :])
         if self.coupling is None:
             return x
         j = schema.N_JOINTS
@@ -65,6 +100,8 @@ class GraphSpec:
             "coupling": None if self.coupling is None else self.coupling.tolist(),
             "sensing": self.sensing,
             "channel_mask": None if self.channel_mask is None else self.channel_mask.tolist(),
+            "schema_nodes": self.schema_nodes,
+            "classes": list(self.classes),
         }
 
 

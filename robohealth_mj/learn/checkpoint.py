@@ -141,6 +141,8 @@ def graph_from_checkpoint(ckpt: dict[str, Any]) -> GraphSpec:
         coupling,
         g.get("sensing", "full"),
         None if mask is None else np.asarray(mask, np.float32),
+        int(g.get("schema_nodes", schema.N_NODES)),  # absent before the stock profile: all
+        tuple(g.get("classes", schema.FAULT_CLASSES)),
     )
 
 

@@ -9,6 +9,8 @@ from typing import Any
 
 from robohealth_mj.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.data.arrays import load_recordings
+from robohealth_mj.data.read import recording_sensing
+from robohealth_mj.data.sensing import refuse_missing_channels
 from robohealth_mj.data.windows import make_windows, target_joint_moved
 from robohealth_mj.learn.checkpoint import (
     check_schema,
@@ -34,10 +36,11 @@ def evaluate_checkpoint(
     """Rebuild the exact model from its checkpoint and score it on every window of ``data``."""
     ckpt = load_checkpoint(ckpt_path)
     files = expand_paths(data)
+    graph = graph_from_checkpoint(ckpt)
     for f in files:
         check_schema(ckpt, str(f))
-    graph = graph_from_checkpoint(ckpt)
-    rec = load_recordings(files)
+        refuse_missing_channels(graph.sensing, recording_sensing(f), str(f))
+    rec = graph.relabel(load_recordings(files))
     dev = pick_device(device)
     tensors = WindowTensors(
         graph.transform(rec.x), rec, ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy(), dev

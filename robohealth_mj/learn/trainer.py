@@ -139,7 +139,7 @@ def prepare(cfg: DictConfig) -> Prepared:
         torch.set_num_threads(int(cfg.trainer.threads))
     device = pick_device(cfg.trainer.device)
     graph: GraphSpec = instantiate(cfg.graph).with_sensing(instantiate(cfg.sensing))
-    rec = load_recordings(expand_paths(cfg.data.train))
+    rec = graph.relabel(load_recordings(expand_paths(cfg.data.train)))
     x = graph.transform(rec.x)
     windows = make_windows(rec, int(cfg.window), cfg.stride)
     splits = run_aware_split(rec, windows, int(cfg.seed))

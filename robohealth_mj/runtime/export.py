@@ -23,6 +23,8 @@ from torch import nn
 from robohealth_mj import schema
 from robohealth_mj.atomic import atomic_write_bytes
 from robohealth_mj.data.arrays import Recording, load_recordings
+from robohealth_mj.data.read import recording_sensing
+from robohealth_mj.data.sensing import refuse_missing_channels
 from robohealth_mj.data.windows import make_windows
 from robohealth_mj.errors import InputError
 from robohealth_mj.learn.checkpoint import (
@@ -39,8 +41,8 @@ PARITY_TOLERANCE = 1e-4
 
 
 class RawInput(nn.Module):
-    """Schema window -> the sensing profile's channels -> the model's graph (harness mixing) ->
-    training-split z-scores."""
+    """Schema window -> the sensing profile's channels and nodes -> the model's graph (harness
+    mixing) -> training-split z-scores."""
 
     def __init__(
         self,
@@ -48,8 +50,10 @@ class RawInput(nn.Module):
         std: torch.Tensor,
         coupling: np.ndarray | None,
         channel_mask: np.ndarray | None = None,
+        schema_nodes: int = schema.N_NODES,
     ) -> None:
         super().__init__()
+        self.schema_nodes = schema_nodes
         self.register_buffer("mean", mean.float().clone())
         self.register_buffer("std", std.float().clone())
         self.masked = channel_mask is not None
@@ -62,6 +66,8 @@ class RawInput(nn.Module):
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         if self.masked:
             x = x * self.channel_mask
+        if self.schema_nodes < schema.N_NODES:
+            x = x[..., : self.schema_nodes, :]
         if self.mix:
             j = schema.N_JOINTS
             sensor = schema.SENSOR_CHANNELS
@@ -87,8 +93,10 @@ def heldout_recording(ckpt: dict[str, Any], data: str | list[str] | None) -> Rec
     if not data:
         raise ValueError("no held-out data for the parity check: pass data=PATH")
     files = expand_paths(data)
+    sensing = graph_from_checkpoint(ckpt).sensing
     for f in files:
         check_schema(ckpt, str(f))
+        refuse_missing_channels(sensing, recording_sensing(f), str(f))
     return load_recordings(files)
 
 
@@ -199,7 +207,9 @@ def export_checkpoint(
             "export here; export a network variant"
         )
     graph = graph_from_checkpoint(ckpt)
-    pre = RawInput(ckpt["norm_mean"], ckpt["norm_std"], graph.coupling, graph.channel_mask).eval()
+    pre = RawInput(
+        ckpt["norm_mean"], ckpt["norm_std"], graph.coupling, graph.channel_mask, graph.schema_nodes
+    ).eval()
     window = int(ckpt["window"])
     rec = heldout_recording(ckpt, data)
     windows = heldout_windows(rec, window, parity_windows)
@@ -236,6 +246,7 @@ def export_checkpoint(
         parity_error=f"{error:.3g}",
         joint_scores=joint_score_kind(ckpt),
         sensing=graph.sensing,
+        label_set=json.dumps(list(graph.classes)),
         **incremental,
     )
     attach_metadata(tmp, out, metadata)  # writes one self-contained file

@@ -9,6 +9,7 @@ from collections.abc import Iterator
 from robohealth_mj.bags import is_bag
 from robohealth_mj.bags.reader import read_bag_samples
 from robohealth_mj.config import compose_config
+from robohealth_mj.logs import is_log, log_samples
 from robohealth_mj.schema import FaultLabel, GraphSample, SchemaError, validate_sample
 
 
@@ -28,7 +29,12 @@ def sim_stream(
 
 def replay_stream(path: str) -> Iterator[tuple[float, str | GraphSample, FaultLabel | None]]:
     """``(t, sample, truth)`` per recorded sample: a graphs.jsonl's lines (a line that does not
-    parse goes to the runtime as it is, which flags it) or a bag's assembled samples."""
+    parse goes to the runtime as it is, which flags it), a bag's assembled samples or a
+    controller log's ticks."""
+    if is_log(path):  # no ground truth: read as healthy, so evaluate counts false alarms
+        for sample in log_samples(path):
+            yield sample.t, sample, sample.fault
+        return
     if is_bag(path):
         for sample in read_bag_samples(path):
             yield sample.t, sample, sample.fault
