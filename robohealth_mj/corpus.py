@@ -2,7 +2,10 @@
 
 - ``train``: sessions varied in seed, speed/payload grid and length (merged for training);
 - ``heldout``: one session with its own seed (the cited test numbers);
-- ``probe_payload_high``: the same fault mix at a payload outside the training range.
+- ``probe_payload_high``: the same fault mix at a payload outside the training range;
+- any further role the corpus config names (``seed`` or ``seeds``, grid, length, overrides),
+  e.g. ``probe_unseen_arms``: sessions each on its own drawn arm (``arm=varied``), and
+  ``healthy_unseen_arms``: ten healthy minutes of each of those arms, to commission on.
 
 Sessions run in parallel (one process per core by default). A finished session (manifest
 ``complete``) is skipped, so an interrupted corpus resumes where it stopped.
@@ -72,21 +75,23 @@ def plan(corpus: DictConfig, extra: list[str]) -> list[SessionSpec]:
                 ),
             )
         )
-    for role in ("heldout", "probe_payload_high"):
-        r = c[role]
-        specs.append(
-            SessionSpec(
-                role,
-                f"{role}_seed{r['seed']}",
-                (
-                    f"seed={r['seed']}",
-                    *_grid_overrides(r["grid"]),
-                    *_length(r["length"]),
-                    *r.get("overrides", []),
-                    *extra,
-                ),
+    for role, r in c.items():
+        if role in ("name", "seed", "train"):
+            continue
+        for seed in r["seeds"] if "seeds" in r else [r["seed"]]:
+            specs.append(
+                SessionSpec(
+                    role,
+                    f"{role}_seed{seed}",
+                    (
+                        f"seed={seed}",
+                        *_grid_overrides(r["grid"]),
+                        *_length(r["length"]),
+                        *r.get("overrides", []),
+                        *extra,
+                    ),
+                )
             )
-        )
     return specs
 
 

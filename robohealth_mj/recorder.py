@@ -51,6 +51,8 @@ def default_run_id(cfg: DictConfig) -> str:
     """A run id fixed by what was simulated (same config, same id, same bytes)."""
     data = session_config(cfg)
     data["session"] = {k: v for k, v in data["session"].items() if k not in _IDENTITY_EXCLUDE}
+    if not any(v for k, v in data.get("arm", {}).items() if k != "_target_"):
+        data.pop("arm", None)  # the nominal arm, which every recording had before arm draws
     digest = hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:10]
     return f"ur5e-s{cfg.seed}-{digest}"
 
@@ -140,9 +142,10 @@ def _stop_between_chunks():
 
 def build_simulator(cfg: DictConfig) -> ArmSimulator:
     """Instantiate model, curriculum, controller and sensors from the composed config."""
-    model = instantiate(cfg.sim)
+    nominal = instantiate(cfg.sim)
+    model, arm = instantiate(cfg.arm).draw(nominal, cfg.seed)  # the physics: this session's arm
     curriculum = instantiate(cfg.curriculum, seed=cfg.seed, _convert_="all")
-    controller = instantiate(cfg.control, model=model)
+    controller = instantiate(cfg.control, model=nominal)  # the controller: the datasheet's
     sensors = instantiate(cfg.sensors, physics_rate_hz=1.0 / model.opt.timestep, _convert_="all")
     tick_s = round(1.0 / (cfg.session.tick_hz * model.opt.timestep)) * model.opt.timestep
     schedule = instantiate(cfg.faults.schedule, tick_s=tick_s, seed=cfg.seed, _convert_="all")
@@ -150,7 +153,7 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
     faults = FaultInjector(
         schedule, params, cfg.faults.fault_model, model, tick_s, cfg.seed, ramp_s=cfg.faults.ramp_s
     )
-    return ArmSimulator(
+    sim = ArmSimulator(
         model,
         curriculum,
         controller,
@@ -160,6 +163,8 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
         chunk_s=cfg.session.chunk_s,
         faults=faults,
     )
+    sim.arm = arm  # the drawn factors ({} for the nominal arm), for the manifest
+    return sim
 
 
 @dataclass
@@ -191,6 +196,7 @@ def record_session(cfg: DictConfig, out_dir: Path | str) -> RecordingResult:
         "rates": {"physics_hz": 1.0 / sim.dt, "tick_hz": 1.0 / sim.tick_s},
         "expected_samples": n_ticks,
         "faults": sim.faults.describe(),
+        "arm": sim.arm,
         "config": session_config(cfg),
     }
     atomic_write_json(out_dir / MANIFEST_FILE, manifest)

@@ -98,6 +98,13 @@ def _get(run: dict[str, Any], *path: str) -> Any:
     return value
 
 
+def _recall(run: dict[str, Any], fault: str) -> float | None:
+    """Held-out recall of ``fault``, None where its label set has no such class (no support)."""
+    if not _get(run, "heldout", "per_class", fault, "support"):
+        return None
+    return _get(run, "heldout", "per_class", fault, "recall")
+
+
 def _rank(label: str) -> int:
     base = label.split("+")[0]
     return VARIANT_ORDER.index(base) if base in VARIANT_ORDER else 99
@@ -402,10 +409,7 @@ def visibility_markdown(runs: list[dict[str, Any]]) -> str:
         "|---|---|---|" + "---|" * len(head),
     ]
     for key, members in grouped(runs):
-        cells = [
-            _fmt(_mean_std([_get(m, "heldout", "per_class", c, "recall") for m in members]))
-            for c in FAULTS
-        ]
+        cells = [_fmt(_mean_std([_recall(m, c) for m in members])) for c in FAULTS]
         cells += [
             _fmt(_mean_std([_get(m, "heldout", group, name, "accuracy") for m in members]))
             for group, name in strata
