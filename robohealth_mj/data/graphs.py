@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.data.baseline import shift
 from robohealth_mj.errors import InputError
 
 # Every joint reaches at least one sensor, and every joint's row is distinct, so the six joints
@@ -41,6 +42,7 @@ class GraphSpec:
     channel_mask: np.ndarray | None = None  # [12, F] 1 kept / 0 zeroed, on the schema's nodes
     schema_nodes: int = schema.N_NODES  # the leading schema nodes read (6: the joints only)
     classes: tuple[str, ...] = schema.FAULT_CLASSES  # the label set (the profile's)
+    baseline_shift: np.ndarray | None = None  # [6, 2, B] commissioning (data/baseline.py)
 
     def with_sensing(self, profile) -> GraphSpec:
         """This graph reading only the channels ``profile`` (a SensingProfile) names; without
@@ -78,6 +80,8 @@ class GraphSpec:
 
     def transform(self, x: np.ndarray) -> np.ndarray:
         """Schema snapshots ``[..., 12, F]`` -> this graph's node features ``[..., N, F]``."""
+        if self.baseline_shift is not None:  # this arm's residuals onto the training arms'
+            x = shift(x, self.baseline_shift).astype(np.float32)
         if self.channel_mask is not None:
             x = (x * self.channel_mask).astype(np.float32)
         if self.schema_nodes < x.shape[-2]:
@@ -102,6 +106,7 @@ class GraphSpec:
             "channel_mask": None if self.channel_mask is None else self.channel_mask.tolist(),
             "schema_nodes": self.schema_nodes,
             "classes": list(self.classes),
+            "baseline_shift": None if self.baseline_shift is None else self.baseline_shift.tolist(),
         }
 
 

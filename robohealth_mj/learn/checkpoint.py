@@ -143,6 +143,7 @@ def graph_from_checkpoint(ckpt: dict[str, Any]) -> GraphSpec:
         None if mask is None else np.asarray(mask, np.float32),
         int(g.get("schema_nodes", schema.N_NODES)),  # absent before the stock profile: all
         tuple(g.get("classes", schema.FAULT_CLASSES)),
+        None if g.get("baseline_shift") is None else np.asarray(g["baseline_shift"], np.float32),
     )
 
 

@@ -23,6 +23,7 @@ from torch import nn
 from robohealth_mj import schema
 from robohealth_mj.atomic import atomic_write_bytes
 from robohealth_mj.data.arrays import Recording, load_recordings
+from robohealth_mj.data.baseline import shift
 from robohealth_mj.data.read import recording_sensing
 from robohealth_mj.data.sensing import refuse_missing_channels
 from robohealth_mj.data.windows import make_windows
@@ -41,8 +42,9 @@ PARITY_TOLERANCE = 1e-4
 
 
 class RawInput(nn.Module):
-    """Schema window -> the sensing profile's channels and nodes -> the model's graph (harness
-    mixing) -> training-split z-scores."""
+    """Schema window -> the commissioned arm's residuals onto the training arms' baseline -> the
+    sensing profile's channels and nodes -> the model's graph (harness mixing) -> training-split
+    z-scores."""
 
     def __init__(
         self,
@@ -51,9 +53,13 @@ class RawInput(nn.Module):
         coupling: np.ndarray | None,
         channel_mask: np.ndarray | None = None,
         schema_nodes: int = schema.N_NODES,
+        baseline_shift: np.ndarray | None = None,
     ) -> None:
         super().__init__()
         self.schema_nodes = schema_nodes
+        self.shifted = baseline_shift is not None
+        if self.shifted:
+            self.register_buffer("baseline_shift", torch.as_tensor(baseline_shift).float())
         self.register_buffer("mean", mean.float().clone())
         self.register_buffer("std", std.float().clone())
         self.masked = channel_mask is not None
@@ -64,6 +70,8 @@ class RawInput(nn.Module):
             self.register_buffer("coupling", torch.as_tensor(coupling, dtype=torch.float32))
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
+        if self.shifted:
+            x = shift(x, self.baseline_shift)
         if self.masked:
             x = x * self.channel_mask
         if self.schema_nodes < schema.N_NODES:
@@ -208,7 +216,12 @@ def export_checkpoint(
         )
     graph = graph_from_checkpoint(ckpt)
     pre = RawInput(
-        ckpt["norm_mean"], ckpt["norm_std"], graph.coupling, graph.channel_mask, graph.schema_nodes
+        ckpt["norm_mean"],
+        ckpt["norm_std"],
+        graph.coupling,
+        graph.channel_mask,
+        graph.schema_nodes,
+        graph.baseline_shift,
     ).eval()
     window = int(ckpt["window"])
     rec = heldout_recording(ckpt, data)
@@ -247,6 +260,7 @@ def export_checkpoint(
         joint_scores=joint_score_kind(ckpt),
         sensing=graph.sensing,
         label_set=json.dumps(list(graph.classes)),
+        **commissioning_metadata(ckpt),
         **incremental,
     )
     attach_metadata(tmp, out, metadata)  # writes one self-contained file
@@ -256,6 +270,17 @@ def export_checkpoint(
         "parity_error": error,
         "windows": len(windows),
         "metadata": metadata,
+    }
+
+
+def commissioning_metadata(ckpt: dict[str, Any]) -> dict[str, str]:
+    """What a commissioned model was commissioned on (nothing for one that was not)."""
+    record = ckpt.get("commissioning")
+    if not record:
+        return {}
+    return {
+        "commissioning_data_fingerprint": record["healthy_fingerprint"],
+        "commissioning_healthy_minutes": str(record["healthy_minutes"]),
     }
 
 

@@ -1,0 +1,48 @@
+"""``python -m robohealth_mj.commission model=CKPT healthy=LOG_OR_DIR [out=DIR]``.
+
+Commissions a trained model on a new arm from minutes of its healthy running (no labels): the
+healthy baseline of the residual channels is refitted (:mod:`robohealth_mj.runtime.commission`),
+a new checkpoint and ONNX are written whose metadata records the commissioning data's
+fingerprint, and the table says after how many healthy minutes the baseline settled.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from omegaconf import OmegaConf
+
+from robohealth_mj.atomic import atomic_write_json
+from robohealth_mj.config import load_cli_config
+from robohealth_mj.errors import InputError, one_line_errors
+from robohealth_mj.runtime.commission import SETTLED, commission
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = sys.argv[1:] if argv is None else argv
+    cfg = load_cli_config("commission", args, "robohealth_mj.commission")
+    with one_line_errors("commission"):
+        if not cfg.model or not cfg.healthy:
+            raise InputError("usage: python -m robohealth_mj.commission model=CKPT healthy=DATA")
+        healthy = (
+            OmegaConf.to_container(cfg.healthy) if OmegaConf.is_list(cfg.healthy) else cfg.healthy
+        )
+        out = Path(cfg.out or Path(cfg.model).parent / "commissioned")
+        record = commission(cfg.model, healthy, out, cfg.reference, cfg.export)
+        atomic_write_json(out / "commissioning.json", record)
+    print(f"{record['healthy_minutes']:g} healthy minutes -> {record['checkpoint']}")
+    for row in record["settling"]:
+        print(f"  after {row['minutes']:>4g} min: {row['relative_error']:.3f} of the final shift")
+    settled = record["settled_minutes"]
+    print(
+        f"baseline settled (within {SETTLED:.0%}) after {settled:g} min"
+        if settled is not None
+        else f"baseline not settled within {SETTLED:.0%}: record more healthy running"
+    )
+    if "onnx" in record:
+        print(f"exported -> {record['onnx']}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,128 @@
+"""Commissioning a model on a new arm: minutes of its healthy running, no labels.
+
+What is arm-specific is refitted and the rest kept: the healthy baseline of the residual
+channels (its constant term is the normalisation's offset; see :mod:`robohealth_mj.data.baseline`)
+is fitted on the new arm and on the model's own training arms (their healthy ticks), and the
+difference rides with the graph into the checkpoint and the exported model's input stage. The
+report says how many healthy minutes the baseline needed to settle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robohealth_mj.data import baseline
+from robohealth_mj.data.arrays import Recording, load_recordings
+from robohealth_mj.data.read import recording_sensing
+from robohealth_mj.data.sensing import refuse_missing_channels
+from robohealth_mj.errors import InputError
+from robohealth_mj.learn.checkpoint import (
+    check_schema,
+    graph_from_checkpoint,
+    load_checkpoint,
+    model_from_checkpoint,
+    save_checkpoint,
+)
+from robohealth_mj.learn.trainer import CHECKPOINT, expand_paths
+from robohealth_mj.runtime.export import export_checkpoint, file_fingerprint
+
+MINUTES = (0.5, 1.0, 2.0, 3.0, 5.0, 7.5, 10.0, 15.0, 20.0)
+SETTLED = 0.1  # a baseline has settled when it moves the residuals within 10 % of the final fit
+
+
+def _healthy(ckpt: dict, paths: list[str] | str, what: str) -> Recording:
+    files = expand_paths(paths)
+    graph = graph_from_checkpoint(ckpt)
+    for f in files:
+        check_schema(ckpt, str(f))
+        refuse_missing_channels(graph.sensing, recording_sensing(f), str(f))
+    rec = load_recordings(files)
+    if what == "healthy" and rec.active.any():
+        raise InputError(
+            f"{files[0]}: {int(rec.active.sum())} of the {what} ticks carry an active fault; "
+            "commission on healthy running only"
+        )
+    return rec
+
+
+def settling(x: np.ndarray, tick_hz: float, final: np.ndarray, delta: np.ndarray) -> list[dict]:
+    """For growing prefixes of the healthy data: how far the baseline fitted on that prefix moves
+    the residuals from where the final fit moves them, relative to the final shift's size."""
+    b = baseline.basis(x.astype(np.float64))
+    size = float(np.sqrt(np.mean(np.square(np.einsum("tjb,jcb->tjc", b, delta))))) or 1.0
+    rows = []
+    for minutes in MINUTES:
+        n = int(minutes * 60 * tick_hz)
+        if n > len(x):
+            break
+        gap = np.einsum("tjb,jcb->tjc", b, baseline.fit(x[:n]) - final)
+        rows.append({"minutes": minutes, "relative_error": float(np.sqrt(np.mean(gap**2))) / size})
+    return rows
+
+
+def commission(
+    ckpt_path: Path | str,
+    healthy: list[str] | str,
+    out_dir: Path | str,
+    reference: list[str] | str | None = None,
+    export: bool = True,
+    tick_hz: float = 20.0,
+) -> dict[str, Any]:
+    """Write ``out_dir/best.ckpt`` (and ``model.onnx`` for a network) commissioned on
+    ``healthy``; the commissioning record (also in the checkpoint)."""
+    ckpt = load_checkpoint(ckpt_path)
+    arm = _healthy(ckpt, healthy, "healthy")
+    reference = reference or ckpt["config"].get("data", {}).get("train")
+    if not reference:
+        raise InputError(f"{ckpt_path}: no training data named in it: pass reference=DATA")
+    ref = _healthy(ckpt, reference, "reference")
+    ref_x = ref.x[~ref.active]
+    w_ref, w_arm = baseline.fit(ref_x), baseline.fit(arm.x)
+    delta = (w_arm - w_ref).astype(np.float32)
+    rows = settling(arm.x, tick_hz, w_arm, delta)
+    settled = next(
+        (r["minutes"] for k, r in enumerate(rows)
+         if all(later["relative_error"] <= SETTLED for later in rows[k:])),
+        None,
+    )  # fmt: skip
+    record = {
+        "healthy": [str(p) for p in expand_paths(healthy)],
+        "healthy_fingerprint": arm.fingerprint(),
+        "healthy_minutes": round(len(arm) / tick_hz / 60.0, 2),
+        "reference_fingerprint": ref.fingerprint(),
+        "settling": rows,
+        "settled_minutes": settled,
+        "from_checkpoint": str(ckpt_path),
+    }
+    graph = replace(graph_from_checkpoint(ckpt), baseline_shift=delta)
+    out_dir = Path(out_dir)
+    save_checkpoint(
+        out_dir / CHECKPOINT,
+        model_from_checkpoint(ckpt),
+        model_cfg=ckpt["model_cfg"],
+        variant=ckpt["variant"],
+        graph=graph,
+        window=int(ckpt["window"]),
+        mean=ckpt["norm_mean"].numpy(),
+        std=ckpt["norm_std"].numpy(),
+        config=ckpt["config"],
+        code_version=ckpt["code_version"],
+        data_fingerprint=ckpt["data_fingerprint"],
+        best_epoch=int(ckpt["best_epoch"]),
+        extra={
+            "gamma": ckpt.get("gamma"),
+            "split_runs": ckpt.get("split_runs"),
+            "commissioning": record,
+        },
+    )
+    record["checkpoint"] = str(out_dir / CHECKPOINT)
+    network = not callable(getattr(model_from_checkpoint(ckpt), "fit", None))
+    if export and network:
+        result = export_checkpoint(out_dir / CHECKPOINT, out_dir / "model.onnx", data=healthy)
+        record["onnx"] = result["path"]
+        record["onnx_fingerprint"] = file_fingerprint(result["path"])
+    return record

@@ -1,0 +1,102 @@
+"""Commissioning a model on a new arm from its healthy running: the residual baseline moves by
+what the arm adds, a nominal arm's model stays as it was, and the commissioned ONNX carries it."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import onnxruntime as ort
+import pytest
+
+from robohealth_mj import schema
+from robohealth_mj.commission import main as commission_main
+from robohealth_mj.config import compose_config
+from robohealth_mj.data.arrays import load_recordings
+from robohealth_mj.data.baseline import RESIDUALS, basis
+from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
+from robohealth_mj.recorder import record_session
+from robohealth_mj.runtime.commission import commission
+from robohealth_mj.runtime.export import read_metadata
+
+J = schema.N_JOINTS
+ELBOW, RESIDUAL = 2, schema.feature_index("effort_residual")
+OFFSET = 0.8  # N*m: what this arm's elbow adds to the controller's torque residual
+
+
+@pytest.fixture(scope="module")
+def healthy(tmp_path_factory) -> dict[str, Path]:
+    """40 s of healthy running of the nominal arm, and the same with the elbow's torque
+    residual offset (an arm whose controller model is off by a constant there)."""
+    root = tmp_path_factory.mktemp("healthy")
+    cfg = compose_config("record", ["session.progress=false", "faults=none", "seed=5",
+                                    "session.duration_s=40"])  # fmt: skip
+    record_session(cfg, root / "nominal")
+    lines = (root / "nominal" / "graphs.jsonl").read_text().splitlines()
+    shifted = []
+    for line in lines:
+        obj = json.loads(line)
+        for node in (ELBOW, J + ELBOW):  # the joint and the copy on its sensor node
+            obj["x"][node][RESIDUAL] += OFFSET
+        shifted.append(json.dumps(obj))
+    (root / "offset").mkdir()
+    (root / "offset" / "graphs.jsonl").write_text("\n".join(shifted) + "\n")
+    return {"nominal": root / "nominal", "offset": root / "offset"}
+
+
+def _windows(path: Path, window: int) -> np.ndarray:
+    x = load_recordings([path / "graphs.jsonl"]).x
+    return np.ascontiguousarray(np.stack([x[k : k + window] for k in range(0, 600, 25)]))
+
+
+def test_an_offset_moves_the_baseline_by_it_and_the_onnx_undoes_it(
+    stock_deployed, healthy, tmp_path
+):
+    ckpt = stock_deployed["ckpt"]
+    reference = str(Path(stock_deployed["heldout"]).parents[1] / "train_*")
+    plain = commission(ckpt, str(healthy["nominal"]), tmp_path / "a", reference)
+    offset = commission(ckpt, str(healthy["offset"]), tmp_path / "b", reference)
+    shift_a = graph_from_checkpoint(load_checkpoint(plain["checkpoint"])).baseline_shift
+    shift_b = graph_from_checkpoint(load_checkpoint(offset["checkpoint"])).baseline_shift
+    x = load_recordings([healthy["offset"] / "graphs.jsonl"]).x
+    moved = np.einsum("tjb,jcb->tjc", basis(x), shift_b - shift_a)  # [T, 6, 2] per tick
+    expected = np.zeros_like(moved)
+    expected[:, ELBOW, RESIDUALS.index("effort_residual")] = OFFSET
+    np.testing.assert_allclose(moved, expected, atol=2e-3)  # the elbow residual's offset, only
+
+    meta = read_metadata(offset["onnx"])
+    assert meta["commissioning_data_fingerprint"] == offset["healthy_fingerprint"]
+    assert float(meta["commissioning_healthy_minutes"]) == pytest.approx(40 / 60, abs=0.01)
+    window = int(load_checkpoint(ckpt)["window"])
+    runs = {}
+    for name, onnx in (("a", plain["onnx"]), ("b", offset["onnx"])):
+        session = ort.InferenceSession(onnx, providers=["CPUExecutionProvider"])
+        data = healthy["nominal" if name == "a" else "offset"]
+        runs[name] = session.run(None, {"x": _windows(data, window)})[0]
+    np.testing.assert_allclose(runs["a"], runs["b"], atol=1e-3)  # the offset arm reads as nominal
+
+
+def test_commissioning_a_nominal_arm_leaves_its_model_as_it_was(stock_deployed, healthy, tmp_path):
+    """Commissioned on the model's own kind of arm, the baseline barely moves and the exported
+    model decides as the uncommissioned one."""
+    ckpt = stock_deployed["ckpt"]
+    reference = str(Path(stock_deployed["heldout"]).parents[1] / "train_*")
+    record = commission(ckpt, str(healthy["nominal"]), tmp_path / "c", reference)
+    window = int(load_checkpoint(ckpt)["window"])
+    x = _windows(healthy["nominal"], window)
+    before, after = (
+        ort.InferenceSession(str(p), providers=["CPUExecutionProvider"]).run(None, {"x": x})[0]
+        for p in (stock_deployed["onnx"], record["onnx"])
+    )
+    assert np.array_equal(before.argmax(1), after.argmax(1))
+    assert np.abs(before - after).max() < 0.5  # logits; the same decisions
+    assert record["settling"][0]["minutes"] == 0.5 and record["healthy_minutes"] < 1
+
+
+def test_commission_refuses_faulted_data_in_one_line(stock_deployed, capsys):
+    with pytest.raises(SystemExit) as done:
+        commission_main([f"model={stock_deployed['ckpt']}", f"healthy={stock_deployed['heldout']}"])
+    err = capsys.readouterr().err.strip()
+    assert done.value.code == 2 and "\n" not in err
+    assert "carry an active fault; commission on healthy running only" in err
