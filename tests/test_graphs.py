@@ -31,7 +31,7 @@ def test_the_structural_graph_is_the_schema_s_and_leaves_snapshots_as_they_are()
         "name": "structural", "node_names": list(schema.NODE_NAMES),
         "adjacency": schema.adjacency().tolist(), "num_joints": 6, "coupling": None,
         "sensing": "full", "channel_mask": None, "schema_nodes": 12,
-        "classes": list(schema.FAULT_CLASSES),
+        "classes": list(schema.FAULT_CLASSES), "baseline_shift": None,
     }  # fmt: skip
 
 

@@ -30,6 +30,8 @@ def test_the_drawn_arm_is_the_seeds_and_within_its_spreads():
     ratio = a.body_mass[wrist] / nominal.body_mass[wrist]
     assert ratio == pytest.approx(drawn_a["mass"]["wrist_1_link"], abs=1e-5)
     assert set(drawn_a["mass"]) == set(LINKS)
+    again = ArmVariation(**{**SPREAD.spreads(), "seed": 7}).draw(nominal, 99)[1]
+    assert again == drawn_a  # the arm's own seed: the same arm in another session
     assert nominal.dof_frictionloss[0] == 3.0  # the nominal model is left as it was
     same, nothing = ArmVariation().draw(nominal, 7)
     assert same is nominal and nothing == {}

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The thesis's experiment on physics (campaign issue), one block per argument, all into
 # outputs/thesis_physics (a finished run is skipped, so any block resumes after interruption):
-#   bash results/thesis_physics/command.sh corpus matrix matrix_w32 windows harness placements severity report
+#   bash results/thesis_physics/command.sh corpus matrix matrix_w32 windows harness placements severity stock report
 # JOBS parallel runs of one thread each (default 2, for 2 cores); TRAIN_ARGS adds overrides to every
 # run (e.g. "trainer.device=cuda variant=mlp,gat"); CORPUS names the corpus directory.
 set -euo pipefail
@@ -39,6 +39,7 @@ for block in "$@"; do
           variant=anomaly_residual model.anomaly_scores=energy
       done ;;
     severity) timed severity train +experiment=severity ;;
+    stock) timed stock train +experiment=stock ;;  # the stock arm (results/stock/)
     report) $PY -m robohealth_mj.report "$ROOT" ;;
     *) echo "unknown block: $block" >&2; exit 2 ;;
   esac

@@ -32,22 +32,26 @@ class ArmVariation:
     stiffness: float = 0.0  # the drive's stiffness
     armature: float = 0.0  # the rotor's reflected inertia
     mass: float = 0.0  # each link's mass and inertia
+    seed: int | None = None  # the arm's own seed (None: the session's), to run one arm twice
 
     def __post_init__(self) -> None:
-        for name, spread in vars(self).items():
+        for name, spread in self.spreads().items():
             if not 0.0 <= spread < 1.0:
                 raise ValueError(f"arm.{name}: a spread in [0, 1), got {spread}")
 
+    def spreads(self) -> dict[str, float]:
+        return {k: v for k, v in vars(self).items() if k != "seed"}
+
     @property
     def nominal(self) -> bool:
-        return not any(vars(self).values())
+        return not any(self.spreads().values())
 
     def draw(self, model: mujoco.MjModel, seed: int) -> tuple[mujoco.MjModel, dict]:
-        """A copy of ``model`` with this session's arm, and the drawn factors (``{}`` when
-        nominal: the model itself comes back)."""
+        """A copy of ``model`` with this session's arm (drawn from ``self.seed``, else the
+        session's ``seed``), and the drawn factors (``{}`` when nominal: the model itself)."""
         if self.nominal:
             return model, {}
-        rng = np.random.default_rng([int(seed), 18])
+        rng = np.random.default_rng([int(seed if self.seed is None else self.seed), 18])
         arm = copy.copy(model)
         idx = ArmIndex.of(arm)
 
