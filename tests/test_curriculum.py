@@ -78,3 +78,30 @@ def test_reference_poses_stay_clear_of_the_floor_and_of_the_arm_itself(record_cf
                 mujoco.mj_kinematics(model, data)
                 mujoco.mj_collision(model, data)
                 assert data.ncon == 0, (seed, visit, q)
+
+
+def test_pick_and_place_programs_move_point_to_point_and_dwell(record_cfg, model):
+    """The programs unlike the curriculum (family pick_place): every move starts and stops at
+    rest at a waypoint, within the speed limit, clear of contacts, smooth into the next segment;
+    the default families leave them out (the 126 above)."""
+    c = _curriculum(record_cfg, "curriculum.families=[pick_place]", seed=4)
+    assert len(c) == 18 and {s.waveform for s in c.segments} == {"pick_place", "palletise"}
+    data, index = mujoco.MjData(model), ArmIndex.of(model)
+    q_all = []
+    for visit in range(2 * len(c)):
+        sched = c.scheduled(visit)
+        t = sched.t_start + np.arange(0.0, c.segment_s, 0.002)
+        q, qd, _ = c.reference(visit, t)
+        q_all.append(q)
+        assert np.abs(qd).max() <= SPEED_LIMIT
+        np.testing.assert_allclose(q[0], sched.start_pose, atol=1e-9)
+        resting = np.abs(qd).max(axis=1) < 1e-3
+        assert 0.1 < resting.mean() < 0.9  # dwells between moves, and moves
+        for pose in c.waypoints(visit):  # the program passes through every taught pose
+            assert np.abs(q - pose).max(axis=1).min() < 1e-6
+        for pose in q[::50]:
+            index.set_link_pose(data, pose)
+            mujoco.mj_kinematics(model, data)
+            mujoco.mj_collision(model, data)
+            assert data.ncon == 0, (visit, pose)
+    assert np.abs(np.diff(np.concatenate(q_all), axis=0)).max() < SPEED_LIMIT * 0.002 * 1.01

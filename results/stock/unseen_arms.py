@@ -22,6 +22,7 @@ CORPUS = Path(sys.argv[1] if len(sys.argv) > 1 else "outputs/corpus/standard")
 RUNS = Path(sys.argv[2] if len(sys.argv) > 2 else "outputs/thesis_physics/structural/stock/C0")
 OUT = Path("outputs/unseen_arms")
 ARMS = (910, 911, 912)
+PROGRAM = "probe_unseen_program"
 KEYS = ("accuracy", "macro_f1", "localisation_accuracy")
 
 
@@ -41,6 +42,12 @@ def nominal_scores(ckpt: Path) -> dict:
     }
 
 
+def program_scores(ckpt: Path) -> dict:
+    """The pick-and-place and palletising sessions (nominal arm): programs unlike the sweeps."""
+    paths = [str(p) for p in sorted(CORPUS.glob(f"{PROGRAM}_seed*"))]
+    return scores(evaluate_checkpoint(ckpt, paths)["metrics"])
+
+
 def main() -> None:
     rows = {}
     for ckpt in sorted(RUNS.glob("*/w32/seed*/best.ckpt")):
@@ -50,6 +57,9 @@ def main() -> None:
         row = json.loads(done.read_text()) if done.is_file() else {}
         if "nominal" not in row and row:  # the reference sessions, added after the first runs
             row["nominal"] = nominal_scores(ckpt)
+            atomic_write_json(done, row)
+        if "program" not in row and row and (CORPUS / f"{PROGRAM}_seed930").is_dir():
+            row["program"] = program_scores(ckpt)
             atomic_write_json(done, row)
         if row:
             rows[key] = row
@@ -76,6 +86,35 @@ def main() -> None:
         atomic_write_json(done, row)
         rows[key] = row
     atomic_write_text(Path(__file__).with_name("unseen_arms.md"), table(rows))
+
+
+def program_lines(rows: dict) -> list[str]:
+    """Programs unlike the curriculum, beside the held-out session and the nominal-arm probes."""
+    if not any("program" in r for r in rows.values()):
+        return []
+    lines = [
+        "",
+        "Unseen programs: two sessions of pick-and-place and palletising cycles (family",
+        "`pick_place`, seeds 930-931, nominal arm), which no training session ran:",
+        "",
+        "| variant | seeds | held-out acc. / loc. | nominal-arm probes | unseen program |",
+        "|---|---|---|---|---|",
+    ]
+    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: v != "gbdt"):
+        group = [r for r in rows.values() if r["variant"] == variant and "program" in r]
+        if not group:
+            continue
+        nominal = [n for r in group for n in r["nominal"].values()]
+
+        def pair(sets: list[dict]) -> str:
+            acc = np.mean([m["accuracy"] for m in sets])
+            loc = np.mean([m["localisation_accuracy"] for m in sets])
+            return f"{acc:.3f} / {loc:.3f}"
+
+        cells = [pair([r["heldout"] for r in group]), pair(nominal),
+                 pair([r["program"] for r in group])]  # fmt: skip
+        lines.append(f"| {variant} | {len(group)} | " + " | ".join(cells) + " |")
+    return lines
 
 
 def alarm_lines() -> list[str]:
@@ -147,6 +186,7 @@ def table(rows: dict) -> str:
             f"{max(settled):g}" if len(settled) == len(arms) else "not within 10 min",
         ]
         lines.append(f"| {variant} | {len(group)} | " + " | ".join(cells) + " |")
+    lines += program_lines(rows)
     lines += alarm_lines()
     lines += ["", "Per class (recall, mean over seeds and arms):", ""]
     classes = ["none", "backlash", "friction", "jam", "struct_weaken"]

@@ -1,4 +1,6 @@
-"""The trajectory curriculum (thesis §2.3.2): sweeps, coordinated pairs and whole-arm motion.
+"""The trajectory curriculum (thesis §2.3.2): sweeps, coordinated pairs and whole-arm motion;
+and, for probing programs unlike those, pick-and-place and palletising cycles as taught on a
+pendant (point-to-point moves with dwells, family ``pick_place``; not in the default families).
 
 Speed scales multiply the base excitation frequency; payload scales multiply a nominal payload.
 Segments are shuffled per pass by the session seed. Each segment starts at the previous segment's
@@ -16,8 +18,12 @@ import numpy as np
 
 from robohealth_mj.schema import N_JOINTS
 
-FAMILIES = ("single_joint", "joint_pair", "whole_arm")
+FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place")
 WAVEFORMS = ("sine", "triangle", "compound")
+TASKS = ("pick_place", "palletise")  # the pick_place family's programs
+LEG_S = 0.8  # the shortest point-to-point move at speed scale 1, s
+JOINT_SPEED = 1.0  # rad/s: the fastest joint's peak speed in a move at speed scale 1
+LIFT_RAD = (0.0, -0.25, 0.35, -0.1, 0.0, 0.0)  # from a pick or place pose to above it
 
 
 def _raw_waveform(name: str, phi: np.ndarray) -> np.ndarray:
@@ -134,6 +140,10 @@ class Curriculum:
             out.append(Segment(len(out), "joint_pair", "sine", pair, speed, payload))
         for wave, speed, payload in itertools.product(WAVEFORMS, speeds, payloads):
             out.append(Segment(len(out), "whole_arm", wave, tuple(range(N_JOINTS)), speed, payload))
+        for task, speed, payload in itertools.product(TASKS, speeds, payloads):
+            out.append(
+                Segment(len(out), "pick_place", task, tuple(range(N_JOINTS)), speed, payload)
+            )
         return [s for s in out if s.family in self.families]
 
     def __len__(self) -> int:
@@ -162,11 +172,47 @@ class Curriculum:
     def payload_kg(self, visit: int) -> float:
         return self.nominal_payload_kg * self.scheduled(visit).segment.payload_scale
 
+    def waypoints(self, visit: int) -> np.ndarray:
+        """A pick_place segment's poses ``[K, 6]``, from its start to its centre: over the pick,
+        down, up, over the place (a palletising layer's next cell), down, up, centre."""
+        sched = self.scheduled(visit)
+        rng = np.random.default_rng([self.seed, 3, visit])
+        pick = sched.center + rng.uniform(-0.4, 0.4, N_JOINTS) * self.amplitude
+        if sched.segment.waveform == "palletise":  # cells of a 3 x 2 layer, in turn
+            cell = visit % 6
+            place = self.home + np.array([0.5 + 0.2 * (cell % 3), 0.1 * (cell // 3), 0, 0, 0, 0])
+        else:
+            place = sched.center + rng.uniform(-0.4, 0.4, N_JOINTS) * self.amplitude
+        lift = np.asarray(LIFT_RAD)
+        return np.stack(
+            [sched.start_pose, pick + lift, pick, pick + lift, place + lift, place, place + lift,
+             sched.center]
+        )  # fmt: skip
+
+    def _point_to_point(self, visit: int, tau: np.ndarray) -> np.ndarray:
+        """Quintic moves between the waypoints with equal dwells between them (a taught program:
+        each move starts and stops at rest, so the reference stays C2)."""
+        poses = self.waypoints(visit)
+        speed = self.scheduled(visit).segment.speed_scale
+        # a quintic's peak speed is 1.875 x distance / duration
+        span = np.abs(np.diff(poses, axis=0)).max(axis=1)
+        legs = np.maximum(LEG_S, 1.875 * span / JOINT_SPEED) / speed
+        legs *= min(1.0, 0.9 * self.segment_s / legs.sum())  # a program fits its segment
+        dwell = (self.segment_s - legs.sum()) / (len(legs) + 1)
+        out = np.repeat(poses[:1], len(tau), axis=0)
+        t0 = dwell
+        for k, leg in enumerate(legs):
+            u = _smoothstep((tau[:, 0] - t0) / leg)[:, None]
+            out = out + (poses[k + 1] - poses[k]) * u
+            t0 += leg + dwell
+        return out
+
     def _amplitude(self, segment: Segment) -> np.ndarray:
         factor = {
             "single_joint": 1.0,
             "joint_pair": self.pair_factor,
             "whole_arm": self.whole_factor,
+            "pick_place": 0.0,  # its motion is its waypoints
         }[segment.family]
         amp = np.zeros(N_JOINTS)
         idx = list(segment.joints)
@@ -186,6 +232,8 @@ class Curriculum:
         sched = self.scheduled(visit)
         seg = sched.segment
         tau = np.asarray(t, dtype=float)[:, None] - sched.t_start
+        if seg.family == "pick_place":
+            return self._point_to_point(visit, tau)
         blend = _smoothstep(tau / self.blend_s)
         envelope = blend * _smoothstep((self.segment_s - tau) / self.blend_s)
         omega = 2.0 * np.pi * self.base_frequency_hz * seg.speed_scale
