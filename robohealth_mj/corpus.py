@@ -35,6 +35,7 @@ from tqdm import tqdm
 
 from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.config import compose_config
+from robohealth_mj.errors import one_line_errors
 from robohealth_mj.recorder import GRAPHS_FILE, MANIFEST_FILE, default_run_id, record_session
 from robohealth_mj.schema import SCHEMA_VERSION
 from robohealth_mj.version import code_version
@@ -170,7 +171,8 @@ def main(cfg: DictConfig) -> None:
     out_dir = Path(cfg.out_dir)
     jobs = cfg.jobs or os.cpu_count() or 1
     extra = [f"faults.fault_model={cfg.fault_model}", *cfg.record_overrides]
-    index = build_corpus(cfg.corpus, out_dir, jobs, extra, cfg.progress)
+    with one_line_errors("corpus"):
+        index = build_corpus(cfg.corpus, out_dir, jobs, extra, cfg.progress)
     for role, sessions in index["roles"].items():
         total = sum(s["samples"] for s in sessions)
         print(f"{role:<20} {len(sessions):>3} session(s) {total:>9} samples")

@@ -2,13 +2,15 @@
 
 Library code raises :class:`InputError` (or the schema's ``SchemaError``, a bag's ``BagError``,
 ``FileNotFoundError``) with a message that names the file and the line, field, topic or key; the
-entry points run their work inside :func:`one_line_errors`, which turns exactly those into
+entry points run their work inside :func:`one_line_errors`, which turns exactly those (and a
+config object whose constructor refused a value, which Hydra wraps) into
 ``<prog>: error: <message>`` on stderr and ``SystemExit(2)``. Anything else is a bug and keeps its
 traceback.
 """
 
 from __future__ import annotations
 
+import re
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -29,12 +31,28 @@ def report(prog: str, exc: BaseException) -> int:
     return 2
 
 
+def user_error(exc: BaseException) -> BaseException | None:
+    """The user's error behind ``exc``: itself, or, for a config object Hydra could not build
+    (``_target_``), the user error its constructor raised, prefixed with the config key."""
+    if isinstance(exc, USER_ERRORS):
+        return exc
+    from hydra.errors import InstantiationException
+
+    if isinstance(exc, InstantiationException) and isinstance(exc.__cause__, USER_ERRORS):
+        key = re.search(r"full_key: (\S+)", str(exc))
+        return InputError(f"config '{key.group(1)}': {exc.__cause__}" if key else exc.__cause__)
+    return None
+
+
 @contextmanager
 def one_line_errors(prog: str) -> Iterator[None]:
     try:
         yield
-    except USER_ERRORS as exc:
-        raise SystemExit(report(prog, exc)) from None
+    except Exception as exc:
+        error = user_error(exc)
+        if error is None:
+            raise
+        raise SystemExit(report(prog, error)) from None
 
 
 def exit_status(prog: str, run: Callable[[], int], *also: type[Exception]) -> int:
@@ -44,3 +62,8 @@ def exit_status(prog: str, run: Callable[[], int], *also: type[Exception]) -> in
         return run()
     except (*USER_ERRORS, *also) as exc:
         return report(prog, exc)
+    except Exception as exc:
+        error = user_error(exc)
+        if error is None:
+            raise
+        return report(prog, error)

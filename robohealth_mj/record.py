@@ -13,13 +13,15 @@ import hydra
 from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
+from robohealth_mj.errors import one_line_errors
 from robohealth_mj.recorder import record_session, summary_text
 
 
 @hydra.main(config_path="../conf", config_name="record", version_base="1.3")
 def main(cfg: DictConfig) -> None:
     out_dir = cfg.session.out_dir or HydraConfig.get().runtime.output_dir
-    result = record_session(cfg, out_dir)
+    with one_line_errors("record"):
+        result = record_session(cfg, out_dir)
     print(summary_text(result), flush=True)
 
 

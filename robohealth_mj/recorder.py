@@ -26,6 +26,7 @@ from tqdm import tqdm
 from robohealth_mj.arm import ArmSimulator, TickChunk
 from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.data.jsonl import format_line, node_features
+from robohealth_mj.errors import InputError
 from robohealth_mj.faults.injector import FaultInjector
 from robohealth_mj.schema import (
     EDGES,
@@ -254,13 +255,13 @@ def _session_ticks(cfg: DictConfig, sim: ArmSimulator) -> int:
     if passes is not None:
         pass_ticks = getattr(sim.faults.schedule, "pass_ticks", None)
         if pass_ticks is None:
-            raise ValueError("session.passes needs the fault scheduler (faults=schedule)")
+            raise InputError("session.passes needs the fault scheduler (faults=schedule)")
         if int(passes) < 1:
-            raise ValueError(f"session.passes must be >= 1, got {passes}")
+            raise InputError(f"session.passes must be >= 1, got {passes}")
         return int(passes) * pass_ticks
     duration = float(cfg.session.duration_s)
     if duration <= 0:
-        raise ValueError(f"session.duration_s must be > 0, got {duration}")
+        raise InputError(f"session.duration_s must be > 0, got {duration}")
     return round(duration / sim.tick_s)
 
 

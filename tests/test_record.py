@@ -204,3 +204,32 @@ def test_a_recorded_line_carries_what_each_channel_name_says(monkeypatch):
     for k, axis in enumerate("xyz"):
         close(sensors[..., f[f"acc_{axis}"]], mean_acc[..., k])
     assert not joints[..., schema.SENSOR_CHANNELS].any()  # joint nodes carry no sensor channel
+
+
+@pytest.mark.parametrize(
+    "command, needles",
+    [
+        ("record session.duration_s=-5", ["record: error: session.duration_s must be > 0"]),
+        ("record arm=varied arm.mass=1.5", ["config 'arm'", "arm.mass: a spread in [0, 1)"]),
+        ("record faults.schedule.severities=[]", ["config 'faults.schedule'", "schedule is empty"]),
+        ("train sensing.joint_channels=[torque]", ["train: error: config 'sensing'", "'torque'"]),
+    ],
+)
+def test_a_bad_config_value_is_one_line_and_exit_status_2(command, needles, tmp_path):
+    """A value no constructor accepts, given on the command line: one line naming the key, exit
+    status 2, no traceback (Hydra wraps a refusing ``_target_``; the entry point unwraps it)."""
+    import subprocess
+    import sys
+
+    prog, *overrides = command.split()
+    if prog == "record":
+        overrides += [f"session.out_dir={tmp_path}", "session.progress=false"]
+    else:
+        overrides += [f"out_dir={tmp_path}"]
+    args = [sys.executable, "-m", f"robohealth_mj.{prog}", *overrides]
+    proc = subprocess.run(args, capture_output=True, text=True, timeout=300)
+    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+    assert len(lines) == 1, proc.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]

@@ -125,9 +125,9 @@ def load_coupling(path: str | Path) -> np.ndarray:
         c = np.loadtxt(path, delimiter=",", dtype=np.float32, ndmin=2)
     c = np.asarray(c, dtype=np.float32)
     if c.ndim != 2 or c.shape[0] != schema.N_JOINTS or c.shape[1] < 1:
-        raise ValueError(f"{path}: coupling must be [{schema.N_JOINTS}, M], got {c.shape}")
+        raise InputError(f"{path}: coupling must be [{schema.N_JOINTS}, M], got {c.shape}")
     if not _reaches(c):
-        raise ValueError(f"{path}: {_UNREACHED}")
+        raise InputError(f"{path}: {_UNREACHED}")
     return c
 
 
@@ -148,7 +148,7 @@ def random_coupling(seed: int, sensors: int = 4, joints: int = schema.N_JOINTS) 
     one matrix.
     """
     if not 2 <= sensors <= 2 * joints:
-        raise ValueError(
+        raise InputError(
             f"a random placement needs 2 to {2 * joints} sensors (each joint reaches one or two), "
             f"got {sensors}"
         )
@@ -190,7 +190,7 @@ def harness_graph(
     given = [k for k, v in (("coupling", coupling), ("coupling_file", coupling_file),
                             ("coupling_seed", coupling_seed)) if v is not None]  # fmt: skip
     if len(given) > 1:
-        raise ValueError(f"graph: set one of coupling, coupling_file, coupling_seed (got {given})")
+        raise InputError(f"graph: set one of coupling, coupling_file, coupling_seed (got {given})")
     if coupling_file:
         c = load_coupling(coupling_file)
     elif coupling_seed is not None:

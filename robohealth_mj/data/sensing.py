@@ -39,7 +39,7 @@ class SensingProfile:
     def __post_init__(self) -> None:
         unknown = [c for c in self.classes if c not in schema.FAULT_CLASSES]
         if unknown or "none" not in self.classes:
-            raise ValueError(
+            raise InputError(
                 f"sensing {self.name}: classes must include 'none' and come from "
                 f"{list(schema.FAULT_CLASSES)}, got {list(self.classes)}"
             )
@@ -49,7 +49,7 @@ class SensingProfile:
         ):
             unknown = [n for n in names if n not in allowed]
             if unknown:
-                raise ValueError(
+                raise InputError(
                     f"sensing {self.name}: {kind} {unknown} unknown (one of {list(allowed)})"
                 )
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robohealth_mj.data.arrays import Recording
+from robohealth_mj.errors import InputError
 from robohealth_mj.schema import feature_index
 
 
@@ -34,7 +35,7 @@ class Windows:
 
 def make_windows(rec: Recording, window: int, stride: int | None = None) -> Windows:
     if window < 2:
-        raise ValueError(f"window must be >= 2, got {window}")
+        raise InputError(f"window must be >= 2, got {window}")
     stride = stride or max(1, window // 4)
     # contiguous blocks: same run and consecutive sample indices
     breaks = np.flatnonzero((np.diff(rec.run) != 0) | (np.diff(rec.sample_index) != 1)) + 1
@@ -79,7 +80,7 @@ def run_aware_split(
     run_of = rec.run[windows.end]
     runs, counts = np.unique(run_of, return_counts=True)
     if len(runs) < 3:
-        raise ValueError(
+        raise InputError(
             f"the run-aware split needs at least 3 recording sessions, got "
             f"{len(runs)} ({[rec.run_ids[r] for r in runs]}); record more sessions"
         )

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from robohealth_mj.errors import InputError
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, FaultLabel
 
 MODES: tuple[str, ...] = FAULT_CLASSES[1:]
@@ -26,11 +27,11 @@ class Scenario:
 
     def __post_init__(self) -> None:
         if self.fault_class not in MODES:
-            raise ValueError(f"unknown fault class {self.fault_class!r}; known: {list(MODES)}")
+            raise InputError(f"unknown fault class {self.fault_class!r}; known: {list(MODES)}")
         if not 0 <= self.joint < len(JOINT_NAMES):
-            raise ValueError(f"fault joint index {self.joint} out of range")
+            raise InputError(f"fault joint index {self.joint} out of range")
         if not 0.0 <= self.severity <= 1.0:
-            raise ValueError(f"fault severity {self.severity} outside [0, 1]")
+            raise InputError(f"fault severity {self.severity} outside [0, 1]")
 
     @property
     def label(self) -> FaultLabel:
@@ -54,7 +55,7 @@ class FaultParameters:
         seed: int = 0,
     ) -> None:
         if not 0.0 <= spread < 1.0:
-            raise ValueError(f"faults.randomise_spread must be in [0, 1), got {spread}")
+            raise InputError(f"faults.randomise_spread must be in [0, 1), got {spread}")
         self.randomised = bool(randomise)
         physics, analytic = copy.deepcopy(dict(physics)), copy.deepcopy(dict(analytic))
         if self.randomised:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from robohealth_mj.errors import InputError
 from robohealth_mj.faults.catalogue import FAULT_MODELS, MECHANICAL, FaultParameters
 from robohealth_mj.faults.mechanical import DriveFaults
 from robohealth_mj.faults.readings import ReadingFaults, TickReadings
@@ -34,7 +35,7 @@ class FaultInjector:
         ramp_s: float = 0.5,
     ) -> None:
         if fault_model not in FAULT_MODELS:
-            raise ValueError(f"fault_model must be one of {FAULT_MODELS}, got {fault_model!r}")
+            raise InputError(f"fault_model must be one of {FAULT_MODELS}, got {fault_model!r}")
         self.schedule, self.parameters, self.fault_model = schedule, parameters, fault_model
         self.physics_on = fault_model != "analytic"
         self.ramp_ticks = round(ramp_s / tick_s)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robohealth_mj.errors import InputError
 from robohealth_mj.faults.catalogue import MODES, Scenario
 from robohealth_mj.schema import JOINT_NAMES
 
@@ -52,13 +53,13 @@ class FaultScheduler:
     ) -> None:
         unknown = [j for j in joints if j not in JOINT_NAMES]
         if unknown:
-            raise ValueError(f"unknown joints in faults.joints: {unknown}")
+            raise InputError(f"unknown joints in faults.joints: {unknown}")
         self.scenarios = [
             Scenario(c, JOINT_NAMES.index(j), float(s))
             for j, c, s in itertools.product(joints, classes, severities)
         ]
         if not self.scenarios:
-            raise ValueError("the fault schedule is empty: no joints, classes or severities")
+            raise InputError("the fault schedule is empty: no joints, classes or severities")
         self.fault_ticks = _ticks(fault_s, tick_s, "faults.fault_s")
         self.healthy_ticks = _ticks(healthy_s, tick_s, "faults.healthy_s")
         self.seed = int(seed)
@@ -112,12 +113,12 @@ class FixedFault:
         seed: int = 0,
     ) -> None:
         if joint not in JOINT_NAMES:
-            raise ValueError(f"unknown joint {joint!r}; known: {list(JOINT_NAMES)}")
+            raise InputError(f"unknown joint {joint!r}; known: {list(JOINT_NAMES)}")
         self.scenario_ = Scenario(fault_class, JOINT_NAMES.index(joint), float(severity))
         self.onset = _ticks(onset_s, tick_s, "faults.onset_s", allow_zero=True)
         self.end = 2**62 if end_s is None else _ticks(end_s, tick_s, "faults.end_s")
         if self.end <= self.onset:
-            raise ValueError("faults.end_s must be after faults.onset_s")
+            raise InputError("faults.end_s must be after faults.onset_s")
 
     def interval_at(self, tick: int) -> Interval:
         if tick < self.onset:
@@ -138,5 +139,5 @@ class FixedFault:
 def _ticks(seconds: float, tick_s: float, name: str, allow_zero: bool = False) -> int:
     n = round(seconds / tick_s)
     if abs(n * tick_s - seconds) > 1e-6 or n < (0 if allow_zero else 1):
-        raise ValueError(f"{name}={seconds} must be a positive whole number of {tick_s} s ticks")
+        raise InputError(f"{name}={seconds} must be a positive whole number of {tick_s} s ticks")
     return n

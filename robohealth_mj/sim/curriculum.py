@@ -16,6 +16,7 @@ from functools import cache
 
 import numpy as np
 
+from robohealth_mj.errors import InputError
 from robohealth_mj.schema import N_JOINTS
 
 FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place")
@@ -33,7 +34,7 @@ def _raw_waveform(name: str, phi: np.ndarray) -> np.ndarray:
         return (2.0 / np.pi) * np.arcsin(0.92 * np.sin(phi))
     if name == "compound":
         return np.sin(phi) + 0.35 * np.sin(2.0 * phi + np.pi / 4)
-    raise ValueError(f"unknown waveform {name!r}; known: {WAVEFORMS}")
+    raise InputError(f"unknown waveform {name!r}; known: {WAVEFORMS}")
 
 
 @cache
@@ -97,16 +98,16 @@ class Curriculum:
         seed: int = 0,
     ) -> None:
         if not speed_scales or not payload_scales:
-            raise ValueError("curriculum needs at least one speed scale and one payload scale")
+            raise InputError("curriculum needs at least one speed scale and one payload scale")
         if segment_s < 2.0 * blend_s:
-            raise ValueError(f"segment_s ({segment_s}) must be >= 2 * blend_s ({blend_s})")
+            raise InputError(f"segment_s ({segment_s}) must be >= 2 * blend_s ({blend_s})")
         for name, vec in (
             ("amplitude_rad", amplitude_rad),
             ("center_jitter_rad", center_jitter_rad),
             ("home", home),
         ):
             if len(vec) != N_JOINTS:
-                raise ValueError(f"curriculum.{name} needs {N_JOINTS} values, got {len(vec)}")
+                raise InputError(f"curriculum.{name} needs {N_JOINTS} values, got {len(vec)}")
         self.speed_scales = [float(s) for s in speed_scales]
         self.payload_scales = [float(p) for p in payload_scales]
         self.nominal_payload_kg = float(nominal_payload_kg)
@@ -119,11 +120,11 @@ class Curriculum:
         self.jitter = np.asarray(center_jitter_rad, dtype=float)
         self.home = np.asarray(home, dtype=float)
         if not 0.0 <= payload_ramp_s <= blend_s:
-            raise ValueError(f"payload_ramp_s ({payload_ramp_s}) must be in [0, blend_s]")
+            raise InputError(f"payload_ramp_s ({payload_ramp_s}) must be in [0, blend_s]")
         self.payload_ramp_s = float(payload_ramp_s)
         unknown = sorted(set(families) - set(FAMILIES))
         if unknown or not families:
-            raise ValueError(f"curriculum.families must be a non-empty subset of {FAMILIES}")
+            raise InputError(f"curriculum.families must be a non-empty subset of {FAMILIES}")
         self.families = tuple(families)
         self.seed = int(seed)
         self.segments = self._enumerate()

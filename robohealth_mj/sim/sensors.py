@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
+from robohealth_mj.errors import InputError
 from robohealth_mj.schema import N_JOINTS
 
 BROADBAND_HZ = (20.0, 400.0)
@@ -56,7 +57,7 @@ class _StatefulBandPass:
         low, high = band_hz
         nyquist = rate_hz / 2.0
         if not 0.0 < low < high < nyquist:
-            raise ValueError(
+            raise InputError(
                 f"piezo band {tuple(band_hz)} Hz must satisfy 0 < low < high < {nyquist}"
             )
         self.sos = signal.butter(order, [low, high], btype="bandpass", fs=rate_hz, output="sos")
@@ -81,7 +82,7 @@ class SensorPackage:
         noise: dict | NoiseFloor | None = None,
     ) -> None:
         if len(sub_bands_hz) != len(SUB_BANDS_HZ):
-            raise ValueError(
+            raise InputError(
                 f"sensors.sub_bands_hz needs {len(SUB_BANDS_HZ)} bands (the schema's), "
                 f"got {len(sub_bands_hz)}"
             )

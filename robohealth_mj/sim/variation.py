@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from robohealth_mj.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.model import ArmIndex
 
@@ -37,7 +38,7 @@ class ArmVariation:
     def __post_init__(self) -> None:
         for name, spread in self.spreads().items():
             if not 0.0 <= spread < 1.0:
-                raise ValueError(f"arm.{name}: a spread in [0, 1), got {spread}")
+                raise InputError(f"arm.{name}: a spread in [0, 1), got {spread}")
 
     def spreads(self) -> dict[str, float]:
         return {k: v for k, v in vars(self).items() if k != "seed"}
