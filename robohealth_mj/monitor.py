@@ -86,6 +86,9 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
         evidence=evidence,
     )  # fmt: skip
     if cfg.source == "ros2":
+        if cfg.model and cfg.ros2.layout == "joints":  # a stock arm's topics: joint channels only
+            model_sensing = read_metadata(cfg.model).get("sensing", "full")
+            refuse_missing_channels(model_sensing, "stock", "ros2.layout=joints")
         return _monitor_ros2(cfg, runtime, policy, evidence)
     if cfg.source == "sim":
         stream = sim_stream(list(cfg.sim_overrides), cfg.duration_s)

@@ -4,6 +4,7 @@ message marks its arm and nothing else. Skipped, with the reason, where cycloned
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import json
 import os
@@ -301,5 +302,54 @@ def test_the_aggregated_layout_carries_each_snapshot_whole_over_the_bus(deployed
     expected = [reference.process("arm1", s) for s in samples]
     live = node.arms["arm1"].diagnoses
     assert [d.fault_class for d in live] == [d.fault_class for d in expected]
+    for bus in (robot, monitor_bus):
+        bus.close()
+
+
+def test_a_stock_arm_publishing_its_joint_topics_alone_is_diagnosed_by_a_stock_model(
+    stock_deployed,
+):
+    """``ros2.layout=joints``: a stock arm's own topics (joint state, tracking error; no
+    ground truth, no sensor package). The samples arrive with the joint channels exact and the
+    sensor channels zero, numbered by arrival, and the stock model decides them as on replay."""
+    config = dataclasses.replace(_bus(), depth=64)  # the whole burst kept
+    robot, monitor_bus = Bus(config), Bus(config)
+    samples = list(itertools.islice(read_samples(stock_deployed["heldout"]), 40))
+    node = MonitorNode(monitor_bus, ModelRuntime(stock_deployed["onnx"]), ["cobot"],
+                       layout="joints", require_truth=False, keep_diagnoses=True)  # fmt: skip
+    pub = ArmPublisher(robot, "cobot", layout="joints")
+    assert list(pub.writers) == ["/cobot/joint_states", "/cobot/joint_tracking_error",
+                                 "/cobot/fault_state"]  # fmt: skip
+    got = []
+    node.on_diagnosis = lambda arm, sample, d: got.append(sample)
+    deadline = time.monotonic() + 10.0  # both ends of both data topics matched: no tick lost
+    writers = list(pub.writers.values())[:2]
+    readers = [r for _, _, r in node.arms["cobot"].readers]
+    while time.monotonic() < deadline and not (
+        all(w.get_matched_subscriptions() for w in writers)
+        and all(r.get_matched_publications() for r in readers)
+    ):
+        time.sleep(0.05)
+    for s in samples:
+        pub.publish(s)
+    _spin(node, lambda: len(got) >= len(samples))
+    print(
+        "PROBLEMS",
+        node.arms["cobot"].problems,
+        node.arms["cobot"].last_problem,
+        node.arms["cobot"].problem,
+    )
+    assert [s.sample_index for s in got] == list(range(len(samples)))
+    state = slice(2, 7)
+    for a, b in zip(got, samples, strict=True):
+        np.testing.assert_array_equal(a.x[:, state], b.x[:, state])
+        assert not a.x[:, 7:].any() and a.fault.fault_class == "none"
+    reference = ModelRuntime(stock_deployed["onnx"])
+    expected = [reference.process("cobot", s) for s in samples]
+    live = node.arms["cobot"].diagnoses
+    assert [d.fault_class for d in live] == [d.fault_class for d in expected]
+    assert sum(d.class_probabilities != {} for d in live) > 20  # decided, not warming up
+    for a, b in zip(live, expected, strict=True):
+        assert a.class_probabilities == pytest.approx(b.class_probabilities, abs=1e-5)
     for bus in (robot, monitor_bus):
         bus.close()

@@ -53,11 +53,15 @@ class ArmAssembler:
         require_truth: bool = True,
         late_ticks: int = 10,
         aggregated: str | None = None,
+        sensors: bool = True,
     ) -> None:
         self.arm, self.topics, self.aggregated = arm, topics, aggregated
-        self.require_truth, self.late_ticks = require_truth, late_ticks
+        self.require_truth, self.late_ticks, self.sensors = require_truth, late_ticks, sensors
         if aggregated:  # one array per tick carries the whole snapshot
             self.vibration, self.imu, self.stamped = [], [], [aggregated]
+        elif not sensors:  # a stock arm: its joint state and tracking error only
+            self.vibration, self.imu = [], []
+            self.stamped = [topics.joint_states, topics.joint_errors]
         else:
             self.vibration = [topics.vibration.format(joint=j) for j in JOINT_NAMES]
             self.imu = [topics.imu.format(joint=j) for j in JOINT_NAMES]
@@ -157,8 +161,8 @@ class ArmAssembler:
                     stamp / 1e9,
                     slot[self.topics.joint_states],
                     slot[self.topics.joint_errors],
-                    [slot[t] for t in self.imu],
-                    vibs,
+                    [slot[t] for t in self.imu] if self.sensors else None,
+                    vibs if self.sensors else None,
                     truth,
                     where,
                 )

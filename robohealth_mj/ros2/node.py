@@ -43,15 +43,23 @@ def in_partition(arm: str, partition: str | None) -> bool:
     return zlib.crc32(arm.encode()) % n == k
 
 
-LAYOUTS = ("per_sensor", "aggregated")
+LAYOUTS = ("per_sensor", "aggregated", "joints")
 
 
 def layout_topics(topics: BagTopics, layout: str) -> dict[str, str]:
     """The topics (-> message type) one sample travels on in ``layout``: ``per_sensor`` (the bag
-    layout, 15 messages a tick) or ``aggregated`` (the snapshot in one array, and the truth)."""
+    layout, 15 messages a tick), ``aggregated`` (the snapshot in one array, and the truth) or
+    ``joints`` (a stock arm's own: joint state and tracking error, and the truth where there is
+    one; no sensor package, so those channels stay zero)."""
     if layout not in LAYOUTS:
         raise ValueError(f"ros2.layout must be one of {LAYOUTS}, got {layout!r}")
-    return topics.sample_topics() if layout == "per_sensor" else topics.aggregated_topics()
+    if layout == "aggregated":
+        return topics.aggregated_topics()
+    every = topics.sample_topics()
+    if layout == "joints":
+        own = (topics.joint_states, topics.joint_errors, topics.fault_state)
+        return {t: every[t] for t in own}
+    return every
 
 
 class ArmPublisher:
@@ -75,7 +83,11 @@ class ArmPublisher:
                 (topics.aggregated, self.factory.aggregated(sample)),
                 (topics.fault_state, self.factory.fault_state(sample)),
             ]
-        return self.factory.sample_messages(sample, topics)
+        messages = self.factory.sample_messages(sample, topics)
+        if self.layout == "joints":
+            own = layout_topics(topics, "joints")
+            messages = [(t, m) for t, m in messages if t in own]
+        return messages
 
     def publish(self, sample: GraphSample) -> None:
         for topic, msg in self.messages(sample):
@@ -133,7 +145,8 @@ class MonitorNode:
             names = arm_topics(arm, topics)
             kinds = layout_topics(names, layout)
             aggregated = names.aggregated if layout == "aggregated" else None
-            assembler = ArmAssembler(arm, names, require_truth=require_truth, aggregated=aggregated)
+            assembler = ArmAssembler(arm, names, require_truth=require_truth,
+                                     aggregated=aggregated, sensors=layout != "joints")  # fmt: skip
             readers = [
                 (t, TYPES[kinds[t]], bus.reader(t, TYPES[kinds[t]]))
                 for t in assembler.topic_names()
