@@ -122,6 +122,21 @@ def learnable_corpus(tmp_path_factory) -> Path:
     return Path(cached(tmp_path_factory, "learnable", recorder)["root"])
 
 
+def _tiny_train_config(corpus: Path, *overrides: str):
+    """The training config of the tests' small models: W = 8 on ``corpus``'s sessions."""
+    return compose_config(
+        "train",
+        [
+            f"data.train=[{corpus}/train_*]",
+            f"data.evaluate.heldout={corpus}/heldout",
+            "data.evaluate.probe=null",
+            "trainer.progress=false",
+            "window=8",
+            *overrides,
+        ],
+    )
+
+
 def _train_and_export(corpus: Path, root: Path) -> dict:
     from robohealth_mj.runtime.export import export_checkpoint
     from robohealth_mj.train import run
@@ -132,18 +147,7 @@ def _train_and_export(corpus: Path, root: Path) -> dict:
         "harness": ["variant=anomaly_residual", "model.hidden=8", "trainer.epochs=1"],
     }
     for graph, overrides in models.items():
-        cfg = compose_config(
-            "train",
-            [
-                f"data.train=[{corpus}/train_*]",
-                f"data.evaluate.heldout={corpus}/heldout",
-                "data.evaluate.probe=null",
-                "trainer.progress=false",
-                "window=8",
-                f"graph={graph}",
-                *overrides,
-            ],
-        )
+        cfg = _tiny_train_config(corpus, f"graph={graph}", *overrides)
         run(cfg, root / graph)
         paths[f"{graph}_ckpt"] = str(root / graph / "best.ckpt")
         result = export_checkpoint(root / graph / "best.ckpt", root / graph / "model.onnx")
@@ -169,19 +173,8 @@ def _train_stock(corpus: Path, root: Path) -> dict:
     from robohealth_mj.runtime.export import export_checkpoint
     from robohealth_mj.train import run
 
-    cfg = compose_config(
-        "train",
-        [
-            f"data.train=[{corpus}/train_*]",
-            f"data.evaluate.heldout={corpus}/heldout",
-            "data.evaluate.probe=null",
-            "trainer.progress=false",
-            "trainer.epochs=1",
-            "window=8",
-            "sensing=stock",
-            "variant=stgnn_fixed",
-            "model.hidden=8",
-        ],
+    cfg = _tiny_train_config(
+        corpus, "trainer.epochs=1", "sensing=stock", "variant=stgnn_fixed", "model.hidden=8"
     )
     run(cfg, root / "run")
     onnx = export_checkpoint(root / "run" / "best.ckpt", root / "model.onnx")["path"]
