@@ -144,10 +144,12 @@ def _stop_between_chunks():
 def build_simulator(cfg: DictConfig) -> ArmSimulator:
     """Instantiate model, curriculum, controller and sensors from the composed config."""
     nominal = instantiate(cfg.sim)
-    model, arm = instantiate(cfg.arm).draw(nominal, cfg.seed)  # the physics: this session's arm
+    variation = instantiate(cfg.arm)
+    model, arm = variation.draw(nominal, cfg.seed)  # the physics: this session's arm
     curriculum = instantiate(cfg.curriculum, seed=cfg.seed, _convert_="all")
     controller = instantiate(cfg.control, model=nominal)  # the controller: the datasheet's
     sensors = instantiate(cfg.sensors, physics_rate_hz=1.0 / model.opt.timestep, _convert_="all")
+    variation.apply_to_sensors(sensors, arm)
     tick_s = round(1.0 / (cfg.session.tick_hz * model.opt.timestep)) * model.opt.timestep
     schedule = instantiate(cfg.faults.schedule, tick_s=tick_s, seed=cfg.seed, _convert_="all")
     params = instantiate(cfg.fault_params, seed=cfg.seed, _convert_="all")

@@ -50,3 +50,28 @@ def test_the_physics_runs_the_drawn_arm_and_the_controller_keeps_the_datasheet()
     np.testing.assert_allclose(sim.controller.coulomb, nominal.dof_frictionloss[motor])
     np.testing.assert_array_equal(sim.controller.model.body_mass[:-1], nominal.body_mass[:-1])
     assert build_simulator(compose_config("record", ["seed=3"])).arm == {}
+
+
+def test_each_sensor_package_reads_with_its_drawn_sensitivity_and_noise():
+    """The drawn transducers: a package of gain g reads g x the acceleration (MEMS mean and piezo
+    level alike), and its noise floor scales with its factor."""
+    sim = build_simulator(compose_config("record", ["arm=varied", "seed=3"]))
+    gain = np.array(list(sim.arm["sensor_gain"].values()))
+    np.testing.assert_allclose(sim.sensors.gain, gain)
+    assert ((gain >= 0.9) & (gain <= 1.1)).all() and gain.std() > 0
+    package = build_simulator(compose_config("record", ["seed=3"])).sensors
+    t = np.arange(0, 0.2, 0.001)
+    acc = np.zeros((len(t), 6, 3))
+    acc[:, :, 0] = np.sin(2 * np.pi * 120 * t)[:, None]  # in the piezo's band
+    plain_mean, plain = package.process(acc, 50)
+    package.reset()
+    package.gain = np.array([1.0, 2.0, 1.0, 1.0, 0.5, 1.0])
+    mean, scaled = package.process(acc, 50)
+    np.testing.assert_allclose(mean, plain_mean * package.gain[None, :, None], atol=1e-12)
+    np.testing.assert_allclose(scaled.vib, plain.vib * package.gain[None, :], rtol=1e-9)
+    package.noise_scale = np.array([1.0, 1.0, 3.0, 1.0, 1.0, 1.0])
+    zero = np.zeros((20000, 6, 3))
+    _, _, _, noisy = package.add_noise(np.random.default_rng(0), zero[:, :, 0], zero[:, :, 0],
+                                       zero[:, :, 0], zero)  # fmt: skip
+    std = noisy.std(axis=(0, 2))
+    assert std[2] == pytest.approx(3 * std[0], rel=0.05)

@@ -92,6 +92,9 @@ class SensorPackage:
             for b in (band_hz, *sub_bands_hz)
         ]
         self.noise = noise if isinstance(noise, NoiseFloor) else NoiseFloor(**(noise or {}))
+        # this arm's own transducers (sim/variation.py): sensitivity and noise factor per joint
+        self.gain = np.ones(N_JOINTS)
+        self.noise_scale = np.ones(N_JOINTS)
 
     def reset(self) -> None:
         for f in self.filters:
@@ -111,8 +114,12 @@ class SensorPackage:
         if steps % tick_steps:
             raise ValueError(f"{steps} steps is not a whole number of {tick_steps}-step ticks")
         ticks = steps // tick_steps
+        acc = acc * self.gain[None, :, None]  # each package's sensitivity
         flat = acc.reshape(steps, N_JOINTS * 3)
-        piezo = flat if rng is None else flat + rng.normal(0.0, self.piezo_sigma(), flat.shape)
+        scale = np.repeat(self.noise_scale, 3)[None, :]
+        piezo = (
+            flat if rng is None else flat + rng.normal(0.0, self.piezo_sigma(), flat.shape) * scale
+        )
 
         def per_tick(filtered: np.ndarray) -> np.ndarray:  # [ticks, tick_steps, 6, 3]
             return filtered.reshape(ticks, tick_steps, N_JOINTS, 3)
@@ -144,5 +151,5 @@ class SensorPackage:
             pos + rng.normal(0.0, n.pos, pos.shape),
             vel + rng.normal(0.0, n.vel, vel.shape),
             effort + rng.normal(0.0, n.effort, effort.shape),
-            acc + rng.normal(0.0, n.acc, acc.shape),
+            acc + rng.normal(0.0, n.acc, acc.shape) * self.noise_scale[None, :, None],
         )

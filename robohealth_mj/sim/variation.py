@@ -1,7 +1,8 @@
 """Arms that are not the nominal one: per-session draws of the arm's own physical parameters.
 
 Every real UR5e differs from the datasheet (and from the controller's model of it) within some
-spread: its drives' friction, damping, stiffness and rotor inertia, its links' masses. With a
+spread: its drives' friction, damping, stiffness and rotor inertia, its links' masses, and the
+sensitivity and noise of each sensor package bolted on. With a
 spread set, each session draws its arm from its seed; the physics runs on the drawn arm while the
 controller keeps its nominal model, so the tracking error and torque residual carry the mismatch
 a real controller's model has. The drawn factors go into the manifest.
@@ -33,6 +34,8 @@ class ArmVariation:
     stiffness: float = 0.0  # the drive's stiffness
     armature: float = 0.0  # the rotor's reflected inertia
     mass: float = 0.0  # each link's mass and inertia
+    sensor_gain: float = 0.0  # each sensor package's sensitivity (accelerometer and piezo)
+    sensor_noise: float = 0.0  # each sensor package's noise floor
     seed: int | None = None  # the arm's own seed (None: the session's), to run one arm twice
 
     def __post_init__(self) -> None:
@@ -75,4 +78,14 @@ class ArmVariation:
             arm.body_mass[body] *= k
             arm.body_inertia[body] *= k
         drawn["mass"] = {link: round(float(v), 5) for link, v in zip(LINKS, f, strict=True)}
+        for name in ("sensor_gain", "sensor_noise"):  # applied by the sensor package
+            f = factors(getattr(self, name), len(JOINT_NAMES))
+            drawn[name] = {j: round(float(v), 5) for j, v in zip(JOINT_NAMES, f, strict=True)}
         return arm, drawn
+
+    @staticmethod
+    def apply_to_sensors(sensors, drawn: dict) -> None:
+        """Give ``sensors`` (a SensorPackage) this arm's transducers (nothing for the nominal)."""
+        if "sensor_gain" in drawn:
+            sensors.gain = np.array([drawn["sensor_gain"][j] for j in JOINT_NAMES])
+            sensors.noise_scale = np.array([drawn["sensor_noise"][j] for j in JOINT_NAMES])
