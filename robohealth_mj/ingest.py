@@ -18,31 +18,26 @@ import os
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
-from robohealth_mj import schema
 from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.errors import exit_status
 
 
 def ingest(log: Path, column_map: str | None, out: Path, tick_hz: float) -> dict:
     """Write ``out/graphs.jsonl`` and ``out/manifest.json`` (each atomically); the manifest."""
-    from robohealth_mj.data.jsonl import format_line, node_features
-    from robohealth_mj.logs.convert import SEGMENT, convert_log
+    from robohealth_mj.data.jsonl import format_line
+    from robohealth_mj.logs.convert import convert_log, session_samples
     from robohealth_mj.version import code_version
 
     cmap, sessions = convert_log(log, column_map, tick_hz)
     out.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".graphs.jsonl.", suffix=".tmp", dir=out)
-    no_sensor = np.zeros((schema.N_JOINTS, len(schema.SENSOR_FEATURES)))
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            for s in sessions:
-                for k in range(len(s.t)):
-                    x = node_features(s.state[k], no_sensor)
-                    fault = schema.FaultLabel()
-                    idx, t = int(s.sample_index[k]), float(s.t[k])
-                    handle.write(format_line(s.run_id, idx, t, x, fault, SEGMENT))
+            for session in sessions:
+                for g in session_samples(session):
+                    line = format_line(g.recording_run_id, g.sample_index, g.t, g.x, g.fault,
+                                       g.segment)  # fmt: skip
+                    handle.write(line)
         os.chmod(tmp, 0o644)
         os.replace(tmp, out / "graphs.jsonl")
     except BaseException:

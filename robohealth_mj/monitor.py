@@ -75,6 +75,11 @@ def _policy(key: str, kind: type, cfg: DictConfig):
             raise InputError(f"conf/monitor.yaml {key}: {exc}") from None
 
 
+def _refuse_lacking_data(model: str, data_sensing: str, source: str) -> None:
+    """One line when the data lacks channels the exported model reads."""
+    refuse_missing_channels(read_metadata(model).get("sensing", "full"), data_sensing, source)
+
+
 def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> dict | None:
     """Run the source through the runtime; with ``evaluate``, the on-line figures. Healthy ticks
     count as settled once the window, the evidence and the alarm have had time to let a fault
@@ -87,8 +92,7 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
     )  # fmt: skip
     if cfg.source == "ros2":
         if cfg.model and cfg.ros2.layout == "joints":  # a stock arm's topics: joint channels only
-            model_sensing = read_metadata(cfg.model).get("sensing", "full")
-            refuse_missing_channels(model_sensing, "stock", "ros2.layout=joints")
+            _refuse_lacking_data(cfg.model, "stock", "ros2.layout=joints")
         return _monitor_ros2(cfg, runtime, policy, evidence)
     if cfg.source == "sim":
         stream = sim_stream(list(cfg.sim_overrides), cfg.duration_s)
@@ -99,8 +103,7 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
                 f"controller log (.csv, .parquet) (got {cfg.file})"
             )
         if cfg.model:
-            model_sensing = read_metadata(cfg.model).get("sensing", "full")
-            refuse_missing_channels(model_sensing, recording_sensing(cfg.file), cfg.file)
+            _refuse_lacking_data(cfg.model, recording_sensing(cfg.file), cfg.file)
         stream = replay_stream(cfg.file)
     else:
         raise InputError(f"source must be sim, replay or ros2, got {cfg.source!r}")

@@ -137,6 +137,9 @@ class GraphSample:
     segment: dict[str, Any]
 
 
+# The segment of a sample with no ground truth (a robot's own log or bag): nothing is known of it.
+UNLABELLED_SEGMENT = {"index": 0, "family": "log", "speed_scale": 1.0, "payload_scale": 1.0}
+
 _REQUIRED = {
     "schema_version": str,
     "recording_run_id": str,

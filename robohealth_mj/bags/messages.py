@@ -33,6 +33,7 @@ from robohealth_mj.schema import (
     NODE_NAMES,
     SENSOR_CHANNELS,
     STATE_CHANNELS,
+    UNLABELLED_SEGMENT,
     FaultLabel,
     GraphSample,
 )
@@ -253,10 +254,6 @@ def sample_from_aggregated(t: float, array: Any, fault: Any, where) -> GraphSamp
     x = np.asarray(array.data, np.float64).reshape(N_NODES, N_FEATURES).astype(np.float32)
     label, index, segment, run_id = truth_from_status(fault, where)
     return GraphSample(run_id, index, t, x, label, segment)
-
-
-# The segment of a sample with no ground truth (a robot's own bag or log): nothing is known of it.
-UNLABELLED_SEGMENT = {"index": 0, "family": "log", "speed_scale": 1.0, "payload_scale": 1.0}
 
 
 def sample_from_messages(

@@ -164,6 +164,18 @@ def model_from_checkpoint(ckpt: dict[str, Any]) -> nn.Module:
     return model.eval()
 
 
+def check_recordings(ckpt: dict[str, Any], files: list) -> None:
+    """Refuse, in one line, a recording of another schema or one lacking channels the model reads
+    (its sensing profile's: a full model on a controller log, say)."""
+    from robohealth_mj.data.read import recording_sensing
+    from robohealth_mj.data.sensing import refuse_missing_channels
+
+    sensing = graph_from_checkpoint(ckpt).sensing
+    for f in files:
+        check_schema(ckpt, str(f))
+        refuse_missing_channels(sensing, recording_sensing(f), str(f))
+
+
 def check_schema(ckpt: dict[str, Any], source: str) -> None:
     """Refuse data whose node order or topology differs from what the model was trained on."""
     s = ckpt["schema"]

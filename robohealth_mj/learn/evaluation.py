@@ -9,11 +9,9 @@ from typing import Any
 
 from robohealth_mj.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.data.arrays import load_recordings
-from robohealth_mj.data.read import recording_sensing
-from robohealth_mj.data.sensing import refuse_missing_channels
 from robohealth_mj.data.windows import make_windows, target_joint_moved
 from robohealth_mj.learn.checkpoint import (
-    check_schema,
+    check_recordings,
     graph_from_checkpoint,
     load_checkpoint,
     model_from_checkpoint,
@@ -36,10 +34,8 @@ def evaluate_checkpoint(
     """Rebuild the exact model from its checkpoint and score it on every window of ``data``."""
     ckpt = load_checkpoint(ckpt_path)
     files = expand_paths(data)
+    check_recordings(ckpt, files)
     graph = graph_from_checkpoint(ckpt)
-    for f in files:
-        check_schema(ckpt, str(f))
-        refuse_missing_channels(graph.sensing, recording_sensing(f), str(f))
     rec = graph.relabel(load_recordings(files))
     dev = pick_device(device)
     tensors = WindowTensors(

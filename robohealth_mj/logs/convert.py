@@ -31,7 +31,6 @@ RATE_HZ = (10.0, 500.0)  # the log rates accepted (5 % either side for clock jit
 LIMITS = {"rad": 2 * np.pi * 1.05, "rad/s": 4 * np.pi, "A": 100.0, "N*m": 1000.0}
 HINTS = {"rad": "degrees logged as radians?", "rad/s": "degrees per second as radians?",
          "A": "milliamperes logged as amperes?", "N*m": "a wrong column?"}  # fmt: skip
-SEGMENT = {"index": 0, "family": "log", "speed_scale": 1.0, "payload_scale": 1.0}
 
 
 def is_log(path: Path | str) -> bool:
@@ -175,17 +174,21 @@ def _torque_constants(table: Table, cmap: ColumnMap, idx: np.ndarray) -> np.ndar
     return out
 
 
+def session_samples(session: LogSession) -> Iterator[schema.GraphSample]:
+    """One log session's GraphSamples (healthy, inactive labels; sensor channels zero)."""
+    no_sensor = np.zeros((schema.N_JOINTS, len(schema.SENSOR_FEATURES)))
+    for k in range(len(session.t)):
+        x = node_features(session.state[k], no_sensor).astype(np.float32)
+        yield schema.GraphSample(
+            session.run_id, int(session.sample_index[k]), float(session.t[k]), x,
+            schema.FaultLabel(), dict(schema.UNLABELLED_SEGMENT),
+        )  # fmt: skip
+
+
 def log_samples(
     path: Path | str, column_map: str | Path | ColumnMap | None = None
 ) -> Iterator[schema.GraphSample]:
-    """GraphSamples of a controller log (healthy, inactive labels; sensor channels zero)."""
+    """GraphSamples of a controller log, every session in turn."""
     _, sessions = convert_log(path, column_map)
-    no_sensor = np.zeros((schema.N_JOINTS, len(schema.SENSOR_FEATURES)))
-    for s in sessions:
-        x = node_features(s.state, np.broadcast_to(no_sensor, (len(s.t), *no_sensor.shape)))
-        x = x.astype(np.float32)
-        for k in range(len(s.t)):
-            yield schema.GraphSample(
-                s.run_id, int(s.sample_index[k]), float(s.t[k]), x[k], schema.FaultLabel(),
-                dict(SEGMENT),
-            )  # fmt: skip
+    for session in sessions:
+        yield from session_samples(session)

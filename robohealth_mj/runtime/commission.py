@@ -17,11 +17,9 @@ import numpy as np
 
 from robohealth_mj.data import baseline
 from robohealth_mj.data.arrays import Recording, load_recordings
-from robohealth_mj.data.read import recording_sensing
-from robohealth_mj.data.sensing import refuse_missing_channels
 from robohealth_mj.errors import InputError
 from robohealth_mj.learn.checkpoint import (
-    check_schema,
+    check_recordings,
     graph_from_checkpoint,
     load_checkpoint,
     model_from_checkpoint,
@@ -36,10 +34,7 @@ SETTLED = 0.1  # a baseline has settled when it moves the residuals within 10 % 
 
 def _healthy(ckpt: dict, paths: list[str] | str, what: str) -> Recording:
     files = expand_paths(paths)
-    graph = graph_from_checkpoint(ckpt)
-    for f in files:
-        check_schema(ckpt, str(f))
-        refuse_missing_channels(graph.sensing, recording_sensing(f), str(f))
+    check_recordings(ckpt, files)
     rec = load_recordings(files)
     if what == "healthy" and rec.active.any():
         raise InputError(
@@ -100,9 +95,10 @@ def commission(
     }
     graph = replace(graph_from_checkpoint(ckpt), baseline_shift=delta)
     out_dir = Path(out_dir)
+    model = model_from_checkpoint(ckpt)
     save_checkpoint(
         out_dir / CHECKPOINT,
-        model_from_checkpoint(ckpt),
+        model,
         model_cfg=ckpt["model_cfg"],
         variant=ckpt["variant"],
         graph=graph,
@@ -120,7 +116,7 @@ def commission(
         },
     )
     record["checkpoint"] = str(out_dir / CHECKPOINT)
-    network = not callable(getattr(model_from_checkpoint(ckpt), "fit", None))
+    network = not callable(getattr(model, "fit", None))
     if export and network:
         result = export_checkpoint(out_dir / CHECKPOINT, out_dir / "model.onnx", data=healthy)
         record["onnx"] = result["path"]

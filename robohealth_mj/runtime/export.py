@@ -24,12 +24,10 @@ from robohealth_mj import schema
 from robohealth_mj.atomic import atomic_write_bytes
 from robohealth_mj.data.arrays import Recording, load_recordings
 from robohealth_mj.data.baseline import shift
-from robohealth_mj.data.read import recording_sensing
-from robohealth_mj.data.sensing import refuse_missing_channels
 from robohealth_mj.data.windows import make_windows
 from robohealth_mj.errors import InputError
 from robohealth_mj.learn.checkpoint import (
-    check_schema,
+    check_recordings,
     graph_from_checkpoint,
     load_checkpoint,
     model_from_checkpoint,
@@ -101,10 +99,7 @@ def heldout_recording(ckpt: dict[str, Any], data: str | list[str] | None) -> Rec
     if not data:
         raise ValueError("no held-out data for the parity check: pass data=PATH")
     files = expand_paths(data)
-    sensing = graph_from_checkpoint(ckpt).sensing
-    for f in files:
-        check_schema(ckpt, str(f))
-        refuse_missing_channels(sensing, recording_sensing(f), str(f))
+    check_recordings(ckpt, files)
     return load_recordings(files)
 
 
