@@ -29,7 +29,10 @@ def main(argv: list[str] | None = None) -> None:
             OmegaConf.to_container(cfg.healthy) if OmegaConf.is_list(cfg.healthy) else cfg.healthy
         )
         out = Path(cfg.out or Path(cfg.model).parent / "commissioned")
-        record = commission(cfg.model, healthy, out, cfg.reference, cfg.export)
+        given = OmegaConf.to_container(cfg.placement) if cfg.get("placement") else {}
+        placement = {k: v for k, v in given.items() if v is not None} or None
+        record = commission(cfg.model, healthy, out, cfg.reference, cfg.export, placement=placement,
+                            placement_fit=cfg.placement_fit)  # fmt: skip
         atomic_write_json(out / "commissioning.json", record)
     print(f"{record['healthy_minutes']:g} healthy minutes -> {record['checkpoint']}")
     for row in record["settling"]:
@@ -40,6 +43,24 @@ def main(argv: list[str] | None = None) -> None:
         if settled is not None
         else f"baseline not settled within {SETTLED:.0%}: record more healthy running"
     )
+    if "placement" in record:
+        p = record["placement"]
+        known = (
+            f", corr. with the arm's placement {p['coupling_correlation']:.2f}"
+            if "coupling_correlation" in p
+            else ""
+        )
+        print(
+            f"placement self-calibration ({p['fit']}): C refitted, reconstruction "
+            f"{p['reconstruction_before']:.3f} -> {p['reconstruction_after']:.3f}{known}"
+        )
+    point = record.get("operating_point", {})
+    if "healthy_offset" in point:
+        print(
+            f"healthy operating point: this arm's healthy windows called healthy "
+            f"{point['arm_healthy_rate_before']:.3f} -> {point['arm_healthy_rate_after']:.3f} "
+            f"(validation: {point['validation_healthy_rate']:.3f})"
+        )
     if "onnx" in record:
         print(f"exported -> {record['onnx']}")
 

@@ -15,6 +15,7 @@ from robohealth_mj.commission import main as commission_main
 from robohealth_mj.config import compose_config
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.baseline import RESIDUALS, basis
+from robohealth_mj.data.windows import make_windows
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
 from robohealth_mj.recorder import record_session
 from robohealth_mj.runtime.commission import commission
@@ -27,12 +28,16 @@ OFFSET = 0.8  # N*m: what this arm's elbow adds to the controller's torque resid
 
 @pytest.fixture(scope="module")
 def healthy(tmp_path_factory) -> dict[str, Path]:
-    """40 s of healthy running of the nominal arm, and the same with the elbow's torque
-    residual offset (an arm whose controller model is off by a constant there)."""
+    """40 s of healthy running of the nominal arm, the same with the elbow's torque residual
+    offset (an arm whose controller model is off by a constant there), and 40 s of a
+    pick-and-place program (motion unlike the training sweeps)."""
     root = tmp_path_factory.mktemp("healthy")
     cfg = compose_config("record", ["session.progress=false", "faults=none", "seed=5",
                                     "session.duration_s=40"])  # fmt: skip
     record_session(cfg, root / "nominal")
+    program = ["session.progress=false", "faults=none", "seed=8", "session.duration_s=40",
+               "curriculum.families=[pick_place]"]  # fmt: skip
+    record_session(compose_config("record", program), root / "program")
     lines = (root / "nominal" / "graphs.jsonl").read_text().splitlines()
     shifted = []
     for line in lines:
@@ -42,7 +47,7 @@ def healthy(tmp_path_factory) -> dict[str, Path]:
         shifted.append(json.dumps(obj))
     (root / "offset").mkdir()
     (root / "offset" / "graphs.jsonl").write_text("\n".join(shifted) + "\n")
-    return {"nominal": root / "nominal", "offset": root / "offset"}
+    return {"nominal": root / "nominal", "offset": root / "offset", "program": root / "program"}
 
 
 def _windows(path: Path, window: int) -> np.ndarray:
@@ -100,3 +105,27 @@ def test_commission_refuses_faulted_data_in_one_line(stock_deployed, capsys):
     err = capsys.readouterr().err.strip()
     assert done.value.code == 2 and "\n" not in err
     assert "carry an active fault; commission on healthy running only" in err
+
+
+def test_commissioning_matches_the_healthy_operating_point(deployed, healthy, tmp_path):
+    """On a program unlike its training sweeps, the arm's healthy windows are called healthy at
+    the rate the model calls its validation session's, and the exported model decides with
+    the raised healthy logit."""
+    ckpt = deployed["structural_ckpt"]
+    reference = str(Path(deployed["root"]) / "train_*")
+    record = commission(ckpt, str(healthy["program"]), tmp_path, reference)
+    point = record["operating_point"]
+    assert point["validation_windows"] > 0 and point["arm_windows"] > 0
+    tolerance = 1.0 / point["arm_windows"]
+    # the program's healthy running looks less healthy than the validation session's ...
+    assert point["arm_healthy_rate_before"] < point["validation_healthy_rate"] - 5 * tolerance
+    assert point["healthy_offset"] > 0.0  # ... so the healthy logit is raised
+    assert point["arm_healthy_rate_after"] == pytest.approx(
+        point["validation_healthy_rate"], abs=tolerance
+    )
+    rec = load_recordings([healthy["program"] / "graphs.jsonl"])
+    windows = make_windows(rec, int(load_checkpoint(ckpt)["window"]))
+    x = np.stack([rec.x[s : s + windows.window] for s in windows.start])
+    session = ort.InferenceSession(record["onnx"], providers=["CPUExecutionProvider"])
+    called = session.run(None, {"x": x})[0].argmax(1)
+    assert (called == 0).mean() == pytest.approx(point["arm_healthy_rate_after"], abs=tolerance)

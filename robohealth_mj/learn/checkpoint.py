@@ -161,6 +161,8 @@ def model_from_checkpoint(ckpt: dict[str, Any]) -> nn.Module:
     except RuntimeError as exc:
         first = str(exc).splitlines()[0]
         raise InputError(f"checkpoint key 'state_dict' does not fit its model: {first}") from None
+    if ckpt.get("class_offset") is not None:  # a commissioned healthy operating point
+        model.class_offset.copy_(torch.as_tensor(ckpt["class_offset"], dtype=torch.float32))
     return model.eval()
 
 

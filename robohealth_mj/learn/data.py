@@ -33,10 +33,14 @@ class WindowTensors:
         self.severity = torch.from_numpy(rec.severity).float().to(device)
         self.active = torch.from_numpy(rec.active).to(device)
 
-    def batch(self, windows: Windows, which: np.ndarray | torch.Tensor) -> WindowBatch:
+    def snapshots(self, windows: Windows, which: np.ndarray | torch.Tensor) -> torch.Tensor:
+        """The snapshot indices ``[B, W]`` of the windows ``which``."""
         starts = torch.as_tensor(windows.start[np.asarray(which)], device=self.device)
         offsets = torch.arange(windows.window, device=self.device)
-        idx = starts[:, None] + offsets[None, :]
+        return starts[:, None] + offsets[None, :]
+
+    def batch(self, windows: Windows, which: np.ndarray | torch.Tensor) -> WindowBatch:
+        idx = self.snapshots(windows, which)
         last = idx[:, -1]
         return WindowBatch(
             self.x[idx],

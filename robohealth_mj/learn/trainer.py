@@ -25,10 +25,12 @@ from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.data.arrays import load_recordings, resolve_recordings
 from robohealth_mj.data.graphs import GraphSpec, coupling_correlation, placement_name
 from robohealth_mj.data.windows import make_windows, normalisation, run_aware_split
+from robohealth_mj.errors import InputError
 from robohealth_mj.learn.checkpoint import save_checkpoint
 from robohealth_mj.learn.data import WindowTensors
 from robohealth_mj.learn.loss import loss_from_config
 from robohealth_mj.learn.metrics import compute_metrics
+from robohealth_mj.learn.placements import PlacementPool
 from robohealth_mj.learn.predict import Predictions, predict
 from robohealth_mj.models import build_model
 from robohealth_mj.version import code_version
@@ -131,6 +133,7 @@ class Prepared:
     tensors: WindowTensors
     model: torch.nn.Module
     device: torch.device
+    pool: PlacementPool | None = None  # training under drawn placements (trainer.placements)
 
 
 def prepare(cfg: DictConfig) -> Prepared:
@@ -144,11 +147,39 @@ def prepare(cfg: DictConfig) -> Prepared:
     windows = make_windows(rec, int(cfg.window), cfg.stride)
     splits = run_aware_split(rec, windows, int(cfg.seed))
     mean, std = normalisation(x, splits["train"])
-    tensors = WindowTensors(x, rec, mean, std, device)
     model = build_model(
         cfg.model, graph.adjacency, graph.num_joints, schema.N_FEATURES, int(cfg.window)
     ).to(device)
-    return Prepared(cfg, graph, rec, splits, mean, std, tensors, model, device)
+    pool = None
+    if cfg.trainer.get("placements"):
+        pool = placement_pool(graph, rec, splits["train"], int(cfg.trainer.placements), device)
+        given_placement(model, graph, pool, mean, std)
+    tensors = WindowTensors(x, rec, mean, std, device)
+    return Prepared(cfg, graph, rec, splits, mean, std, tensors, model, device, pool)
+
+
+def placement_pool(graph: GraphSpec, rec, train: Any, size: int, device) -> PlacementPool:
+    """The pool of drawn placements and the packages they mix (the profile's channels), with
+    the healthy training snapshots that z-score them."""
+    covered = np.zeros(len(rec), bool)
+    for offset in range(train.window):
+        covered[train.start + offset] = True
+    x = rec.x if graph.channel_mask is None else rec.x * graph.channel_mask
+    return PlacementPool(graph, x, covered & ~rec.active, size, device)
+
+
+def given_placement(model, graph: GraphSpec, pool: PlacementPool, mean, std) -> None:
+    """A model trained under drawn placements is given its graph's own placement (its ``C``
+    is set, not learned: validation and the checkpoint use it), and that placement's sensors
+    are z-scored on the healthy statistics the pool uses for every other placement."""
+    head = getattr(model, "anomaly", None)
+    if head is None:
+        raise InputError("trainer.placements needs a coupling-head variant (anomaly_residual)")
+    head.set_coupling(graph.coupling)
+    head.coupling_logits.requires_grad_(False)
+    j = graph.num_joints
+    mu, sd = pool.statistics(np.asarray(graph.coupling))
+    mean[j:, schema.SENSOR_CHANNELS], std[j:, schema.SENSOR_CHANNELS] = mu, sd
 
 
 def _save(p: Prepared, out_dir: Path, best_epoch: int, gamma: float | None) -> None:
@@ -202,6 +233,7 @@ def fit_gradient(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
 
     loss_fn = loss_from_config(t)
     generator = torch.Generator().manual_seed(int(cfg.seed))
+    placements = torch.Generator().manual_seed(int(cfg.seed) + 1)  # the pool's draws
     best_score, best_epoch, history, stale = -math.inf, -1, [], 0
     started = time.perf_counter()
     for epoch in range(1, int(t.epochs) + 1):
@@ -216,8 +248,14 @@ def fit_gradient(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
         )
         running = 0.0
         for step, i in enumerate(bar, start=1):
-            batch = p.tensors.batch(train_windows, order[i : i + batch_size])
-            loss, _ = loss_fn(model(batch.x), batch)
+            which = order[i : i + batch_size]
+            batch = p.tensors.batch(train_windows, which)
+            if p.pool is None:
+                out = model(batch.x)
+            else:  # each window under a drawn placement, which the model is given
+                snapshots = p.tensors.snapshots(train_windows, which)
+                out = model(*p.pool.mix(batch.x, snapshots, placements))
+            loss, _ = loss_fn(out, batch)
             optimiser.zero_grad(set_to_none=True)
             loss.backward()
             optimiser.step()
@@ -326,6 +364,7 @@ def train_run(cfg: DictConfig, out_dir: Path) -> dict[str, Any]:
         "graph": p.graph.name,
         "sensing": p.graph.sensing,
         "placement": placement_name(cfg.graph),
+        "placements_drawn": len(p.pool.couplings) if p.pool is not None else 0,
         "anomaly_scores": cfg.model.get("anomaly_scores"),
         "severity_head": bool(cfg.model.get("severity_head", False)),
         "device": str(p.device),

@@ -3,6 +3,7 @@ and the optional severity regressor."""
 
 from __future__ import annotations
 
+import numpy as np
 import torch
 import torch.nn.functional as F
 from torch import nn
@@ -100,23 +101,48 @@ class AnomalyResidualHead(nn.Module):
     def coupling(self) -> torch.Tensor:
         return F.softplus(self.coupling_logits)
 
-    def normalisations(self) -> tuple[torch.Tensor, torch.Tensor]:
-        c = self.coupling()
-        return c / c.sum(dim=0, keepdim=True), c / c.sum(dim=1, keepdim=True)
+    @torch.no_grad()
+    def set_coupling(self, c: torch.Tensor | np.ndarray, floor: float = 1e-2) -> None:
+        """Set ``C`` to a given placement ``[J, M]`` (entries below ``floor`` are raised to it,
+        since softplus never reaches zero): a placement known, or a start for refitting."""
+        c = torch.as_tensor(np.asarray(c), dtype=torch.float32).clamp_min(floor)
+        self.coupling_logits.copy_(torch.log(torch.expm1(c)))
 
-    def forward(self, nodes: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    def normalisations(
+        self, coupling: torch.Tensor | None = None
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """``(C_pred, C_scat)``: ``C`` (the learned one, or ``coupling`` ``[..., J, M]``) with
+        columns and rows summing to 1."""
+        c = self.coupling() if coupling is None else coupling
+        return c / c.sum(dim=-2, keepdim=True), c / c.sum(dim=-1, keepdim=True)
+
+    def forward(
+        self, nodes: torch.Tensor, coupling: torch.Tensor | None = None
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """``nodes [B, N, H]`` -> joint logits and reconstruction energy ``[B, J]``; with
+        ``coupling [B, J, M]`` (each window's placement, given in training under drawn
+        placements) in place of the learned ``C``."""
         h = nodes[:, : self.num_joints]  # [B, J, H]
         s = nodes[:, self.num_joints :]  # [B, M, H]
-        c_pred, c_scat = self.normalisations()
-        predicted = self.f(torch.einsum("jm,bjh->bmh", c_pred, h))
+        c_pred, c_scat = self.normalisations(coupling)
+        per_window = "b" if coupling is not None else ""  # one C for all, or one per window
+        predicted = self.f(torch.einsum(f"{per_window}jm,bjh->bmh", c_pred, h))
         residual = s - predicted
         if self.scores == "signed":
             scores = self.g(residual).squeeze(-1)  # [B, M], any sign
         else:
             scores = self.g(residual).square().mean(-1)  # [B, M], >= 0, grows with |r_m|
-        logits = scores @ c_scat.transpose(0, 1)  # [B, J]
-        energy = residual.square().mean(-1) @ c_scat.transpose(0, 1)  # [B, J], per channel
+        logits = torch.einsum(f"bm,{per_window}jm->bj", scores, c_scat)  # [B, J]
+        energy = torch.einsum(f"bm,{per_window}jm->bj", residual.square().mean(-1), c_scat)
         return logits, energy
+
+    def reconstruction_error(self, nodes: torch.Tensor) -> torch.Tensor:
+        """Each sensor's prediction error from its coupled joints, unweighted by ``C_scat``
+        ``[B, M]``: what refitting ``C`` on healthy running minimises (a weighted energy could
+        be lowered by scattering every sensor onto the joints predicted best)."""
+        c_pred, _ = self.normalisations()
+        predicted = self.f(torch.einsum("jm,bjh->bmh", c_pred, nodes[:, : self.num_joints]))
+        return (nodes[:, self.num_joints :] - predicted).square().mean(-1)
 
 
 class SeverityHead(nn.Module):

@@ -82,6 +82,8 @@ class STGNN(nn.Module):
         )
         self.localise = None if anomaly_head else NodeLocalisationHead(hidden, num_joints, dropout)
         self.severity = SeverityHead(hidden, dropout) if severity_head else None
+        # added to the class logits; set by commissioning (runtime/operating_point.py)
+        self.register_buffer("class_offset", torch.zeros(num_classes), persistent=False)
 
     def node_embeddings(self, x: torch.Tensor) -> torch.Tensor:
         """Refined per-node embeddings ``[B, N, H]`` (what the heads read)."""
@@ -96,9 +98,13 @@ class STGNN(nn.Module):
             features = torch.cat([x, spec], dim=-1)
         return positions, self.backbone(features, adj)
 
-    def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:
+    def forward(
+        self, x: torch.Tensor, coupling: torch.Tensor | None = None
+    ) -> dict[str, torch.Tensor]:
+        """``coupling [B, J, M]``: each window's placement in place of the learned ``C``
+        (training under drawn placements); coupling-head models only."""
         positions, (refined, temporal, skip) = self._features(x)
-        return self.heads(positions, refined, temporal, skip)
+        return self.heads(positions, refined, temporal, skip, coupling)
 
     def heads(
         self,
@@ -106,12 +112,14 @@ class STGNN(nn.Module):
         refined: torch.Tensor,
         temporal: torch.Tensor,
         skip: torch.Tensor,
+        coupling: torch.Tensor | None = None,
     ) -> dict[str, torch.Tensor]:
         """The output heads on the backbone's node embeddings (shared with the incremental
         form): positions ``[B, N]``, embeddings ``[B, N, H]`` -> the output dict."""
-        out = {"class_logits": self.classifier(refined, positions[:, : self.num_joints])}
+        logits = self.classifier(refined, positions[:, : self.num_joints]) + self.class_offset
+        out = {"class_logits": logits}
         if self.anomaly is not None:
-            out["joint_logits"], out["recon_energy"] = self.anomaly(temporal)
+            out["joint_logits"], out["recon_energy"] = self.anomaly(temporal, coupling)
         else:
             out["joint_logits"] = self.localise(refined, skip)
         gamma = self.adjacency.gamma()

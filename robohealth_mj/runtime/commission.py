@@ -4,7 +4,9 @@ What is arm-specific is refitted and the rest kept: the healthy baseline of the 
 channels (its constant term is the normalisation's offset; see :mod:`robohealth_mj.data.baseline`)
 is fitted on the new arm and on the model's own training arms (their healthy ticks), and the
 difference rides with the graph into the checkpoint and the exported model's input stage. The
-report says how many healthy minutes the baseline needed to settle.
+report says how many healthy minutes the baseline needed to settle. A harness model's coupling
+``C`` is refitted to where the arm's sensors sit (placement self-calibration), and last the
+healthy operating point is matched (:mod:`robohealth_mj.runtime.operating_point`).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import numpy as np
 
 from robohealth_mj.data import baseline
 from robohealth_mj.data.arrays import Recording, load_recordings
+from robohealth_mj.data.graphs import GraphSpec, harness_graph
 from robohealth_mj.errors import InputError
 from robohealth_mj.learn.checkpoint import (
     check_recordings,
@@ -27,6 +30,8 @@ from robohealth_mj.learn.checkpoint import (
 )
 from robohealth_mj.learn.trainer import CHECKPOINT, expand_paths
 from robohealth_mj.runtime.export import export_checkpoint, file_fingerprint
+from robohealth_mj.runtime.operating_point import Reading, match_operating_point
+from robohealth_mj.runtime.recouple import recouple
 
 MINUTES = (0.5, 1.0, 2.0, 3.0, 5.0, 7.5, 10.0, 15.0, 20.0)
 SETTLED = 0.1  # a baseline has settled when it moves the residuals within 10 % of the final fit
@@ -59,6 +64,22 @@ def settling(x: np.ndarray, tick_hz: float, final: np.ndarray, delta: np.ndarray
     return rows
 
 
+def arm_placement(graph: GraphSpec, placement: dict | None) -> np.ndarray:
+    """Where this arm's harness sensors sit: ``placement`` (``coupling_seed`` and
+    ``coupling_sensors``, ``coupling_file`` or ``coupling``, as ``graph=harness`` takes them),
+    or the checkpoint's own. The simulation mixes the arm's data by it; the model is not told."""
+    given = {k: v for k, v in (placement or {}).items() if v is not None}
+    if not given:
+        return graph.coupling
+    m = graph.coupling.shape[1]
+    c = harness_graph(**{"coupling_sensors": m, **given}).coupling
+    if c.shape != graph.coupling.shape:
+        raise InputError(
+            f"placement: the model reads {m} sensors, the placement places {c.shape[1]}"
+        )
+    return c
+
+
 def commission(
     ckpt_path: Path | str,
     healthy: list[str] | str,
@@ -66,9 +87,13 @@ def commission(
     reference: list[str] | str | None = None,
     export: bool = True,
     tick_hz: float = 20.0,
+    placement: dict | None = None,
+    placement_fit: str = "motion",
 ) -> dict[str, Any]:
     """Write ``out_dir/best.ckpt`` (and ``model.onnx`` for a network) commissioned on
-    ``healthy``; the commissioning record (also in the checkpoint)."""
+    ``healthy``; the commissioning record (also in the checkpoint). A harness model with a
+    coupling head also has its ``C`` refitted to the arm's ``placement``
+    (:mod:`robohealth_mj.runtime.recouple`)."""
     ckpt = load_checkpoint(ckpt_path)
     arm = _healthy(ckpt, healthy, "healthy")
     reference = reference or ckpt["config"].get("data", {}).get("train")
@@ -96,6 +121,26 @@ def commission(
     graph = replace(graph_from_checkpoint(ckpt), baseline_shift=delta)
     out_dir = Path(out_dir)
     model = model_from_checkpoint(ckpt)
+    mean, std = ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()
+    if graph.coupling is not None and getattr(model, "anomaly", None) is not None:
+        graph = replace(graph, coupling=arm_placement(graph, placement))
+        drawn = int((ckpt["config"].get("trainer") or {}).get("placements") or 0)
+        mean, std, record["placement"] = recouple(
+            model, graph, arm, ref, mean, std, int(ckpt["window"]), placement_fit, drawn > 0
+        )
+    elif placement:
+        raise InputError(
+            f"{ckpt_path}: placement= is for harness models with a coupling head; "
+            "this model has no placement to calibrate"
+        )
+    trained = graph_from_checkpoint(ckpt)
+    offset, record["operating_point"] = match_operating_point(
+        model,
+        int(ckpt["window"]),
+        Reading(ref, trained, ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()),
+        list((ckpt.get("split_runs") or {}).get("val", [])),
+        Reading(arm, graph, mean, std),
+    )
     save_checkpoint(
         out_dir / CHECKPOINT,
         model,
@@ -103,8 +148,8 @@ def commission(
         variant=ckpt["variant"],
         graph=graph,
         window=int(ckpt["window"]),
-        mean=ckpt["norm_mean"].numpy(),
-        std=ckpt["norm_std"].numpy(),
+        mean=mean,
+        std=std,
         config=ckpt["config"],
         code_version=ckpt["code_version"],
         data_fingerprint=ckpt["data_fingerprint"],
@@ -113,6 +158,7 @@ def commission(
             "gamma": ckpt.get("gamma"),
             "split_runs": ckpt.get("split_runs"),
             "commissioning": record,
+            "class_offset": offset.tolist(),
         },
     )
     record["checkpoint"] = str(out_dir / CHECKPOINT)
