@@ -8,3 +8,18 @@ CORPUS=$CORPUS bash results/thesis_physics/command.sh stock matrix_w32   # 3 see
 $PY results/stock/compare.py                                        # -> stock_vs_full.md
 $PY results/stock/unseen_arms.py "$CORPUS"                          # -> unseen_arms.md
 bash results/stock/alarms.sh "$CORPUS" && $PY results/stock/unseen_arms.py "$CORPUS"
+# Placement self-calibration (retrofit harness, W = 32, seed 42): a model trained under 256 drawn
+# placements, models trained on each test placement (the references), then commissioning.
+H="graph=harness sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy window=32"
+D="data.train=[$CORPUS/train_*] data.evaluate.heldout=$CORPUS/heldout_seed900"
+# shellcheck disable=SC2086
+$PY -m robohealth_mj.train $H $D data.evaluate.probe=null trainer.placements=256 \
+  trainer.epochs=40 trainer.patience=8 trainer.threads=1 out_dir=outputs/selfcal/pool256_e40
+# shellcheck disable=SC2086
+$PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs=2 trainer.threads=1 \
+  hydra.sweep.dir=outputs/thesis_physics $D data.evaluate.probe=$CORPUS/probe_payload_high_seed901 \
+  +experiment=placements sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy \
+  graph.coupling_sensors=4 graph.coupling_seed=2,5,21,22,23
+$PY results/stock/self_calibration.py outputs/selfcal/pool256_e40/best.ckpt \
+  outputs/thesis_physics/harness/retrofit/C0/anomaly_residual/w32/seed42/best.ckpt \
+  > results/stock/self_calibration.md

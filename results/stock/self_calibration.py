@@ -5,7 +5,7 @@ trained on that placement. Retrofit sensing, W = 32, held-out session.
     .venv/bin/python results/stock/self_calibration.py POOL_CKPT [SINGLE_CKPT] \
         > results/stock/self_calibration.md
 
-POOL_CKPT: trained with ``trainer.placements=64`` (command in results/stock/command.sh);
+POOL_CKPT: trained with ``trainer.placements=256`` (command in results/stock/command.sh);
 SINGLE_CKPT: the campaign's model trained on C0 alone (for contrast). Trained-on-placement
 references: the campaign's runs under ``outputs/thesis_physics/harness/retrofit/<placement>``.
 """
@@ -79,6 +79,14 @@ def fmt(s: tuple[float, float]) -> str:
 pool_path = sys.argv[1]
 single_path = sys.argv[2] if len(sys.argv) > 2 else None
 pool = load_checkpoint(pool_path)
+print("# Placement self-calibration (retrofit harness, W = 32, seed 42, held-out session)\n")
+print(f"Made by `.venv/bin/python results/stock/self_calibration.py {' '.join(sys.argv[1:])}`.")
+print(
+    "Accuracy / localisation. *Told it*: the pool model given the true placement. "
+    "*Self-calibrated*: commissioned on ten healthy minutes (seed 940) with the placement "
+    "hidden; commissioning also matches the healthy operating point, so its accuracy can "
+    "differ from *told it*. corr: mean over joints of the row correlation with the truth.\n"
+)
 print("| placement | trained on it (acc. / loc.) | pool model, told it | pool model, "
       "self-calibrated: motion fit | corr(C, truth) | reconstruction fit | corr(C, truth) | "
       "C0-only model, motion fit |")  # fmt: skip
