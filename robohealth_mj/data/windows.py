@@ -99,13 +99,18 @@ def run_aware_split(
     return {name: windows.subset(which == i) for i, name in enumerate(SPLITS)}
 
 
+def covered(windows: Windows, length: int) -> np.ndarray:
+    """``[length]`` bool: the snapshots some window of ``windows`` covers."""
+    mask = np.zeros(length, bool)
+    for offset in range(windows.window):
+        mask[windows.start + offset] = True
+    return mask
+
+
 def normalisation(x: np.ndarray, windows: Windows) -> tuple[np.ndarray, np.ndarray]:
     """Per-node, per-feature mean and std ``[N, F]`` over every snapshot the (training) windows
     cover, and nothing else: no held-out information leaks through the z-scoring."""
-    covered = np.zeros(len(x), bool)
-    for offset in range(windows.window):
-        covered[windows.start + offset] = True
-    x = x[covered].astype(np.float64)
+    x = x[covered(windows, len(x))].astype(np.float64)
     mean = x.mean(axis=0)
     std = x.std(axis=0)
     std[std < 1e-6] = 1.0  # constant channels (type indicators, zeroed channels) pass through

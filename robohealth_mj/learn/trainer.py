@@ -24,7 +24,7 @@ from robohealth_mj import schema
 from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.data.arrays import load_recordings, resolve_recordings
 from robohealth_mj.data.graphs import GraphSpec, coupling_correlation, placement_name
-from robohealth_mj.data.windows import make_windows, normalisation, run_aware_split
+from robohealth_mj.data.windows import covered, make_windows, normalisation, run_aware_split
 from robohealth_mj.errors import InputError
 from robohealth_mj.learn.checkpoint import save_checkpoint
 from robohealth_mj.learn.data import WindowTensors
@@ -161,11 +161,8 @@ def prepare(cfg: DictConfig) -> Prepared:
 def placement_pool(graph: GraphSpec, rec, train: Any, size: int, device) -> PlacementPool:
     """The pool of drawn placements and the packages they mix (the profile's channels), with
     the healthy training snapshots that z-score them."""
-    covered = np.zeros(len(rec), bool)
-    for offset in range(train.window):
-        covered[train.start + offset] = True
     x = rec.x if graph.channel_mask is None else rec.x * graph.channel_mask
-    return PlacementPool(graph, x, covered & ~rec.active, size, device)
+    return PlacementPool(graph, x, covered(train, len(rec)) & ~rec.active, size, device)
 
 
 def given_placement(model, graph: GraphSpec, pool: PlacementPool, mean, std) -> None:

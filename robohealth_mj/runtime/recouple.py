@@ -126,8 +126,8 @@ def recouple(
     profile, commissioning shift and the placement the sensors really sit in). With
     ``refit_sensor_statistics`` the sensors are z-scored on this arm's healthy running, as the
     model was trained (``trainer.placements``). Returns the normalisation and a record: the
-    model's reconstruction error before and after and, where the placement is known
-    (simulation), the refitted ``C``'s correlation with it."""
+    refitted ``C``, the reconstruction fit's error before and after and, where the placement is
+    known (simulation), ``C``'s correlation with it."""
     if fit not in FITS:
         raise InputError(f"placement_fit must be one of {FITS}, got {fit!r}")
     mean, std = mean.copy(), std.copy()
@@ -135,32 +135,25 @@ def recouple(
     if refit_sensor_statistics:
         mu, sd = healthy_sensor_statistics(world, arm.x)
         mean[j:, SENSORS], std[j:, SENSORS] = mu, sd
-    tensors = WindowTensors(world.transform(arm.x), arm, mean, std, torch.device("cpu"))
-    windows = make_windows(arm, window)
     head = model.anomaly
-    model.eval()
-    n = len(windows)
-    with torch.no_grad():  # the backbone is frozen: the embeddings the head reads, once
-        nodes = torch.cat([
-            model._features(tensors.batch(windows, np.arange(i, min(i + 512, n))).x)[1][1]
-            for i in range(0, n, 512)
-        ])  # fmt: skip
+    record: dict[str, Any] = {"fit": fit}
     if fit == "reconstruction":
+        model.eval()
+        tensors = WindowTensors(world.transform(arm.x), arm, mean, std, torch.device("cpu"))
+        windows = make_windows(arm, window)
+        n = len(windows)
+        with torch.no_grad():  # the backbone is frozen: the embeddings the head reads, once
+            nodes = torch.cat([
+                model._features(tensors.batch(windows, np.arange(i, min(i + 512, n))).x)[1][1]
+                for i in range(0, n, 512)
+            ])  # fmt: skip
         before, after = reconstruction_estimate(head, nodes, seed)
+        record.update(reconstruction_before=before, reconstruction_after=after)
     else:
-        with torch.no_grad():
-            head.coupling_logits.normal_(0.0, head.init_noise)
-            before = float(head.reconstruction_error(nodes).mean())
-            head.set_coupling(motion_estimate(reference, arm, world))
-            after = float(head.reconstruction_error(nodes).mean())
+        head.set_coupling(motion_estimate(reference, arm, world))
     coupling = head.coupling().detach().numpy()
-    record: dict[str, Any] = {
-        "fit": fit,
-        "coupling": coupling.round(5).tolist(),
-        "reconstruction_before": before,
-        "reconstruction_after": after,
-        "sensor_statistics": "refitted" if refit_sensor_statistics else "kept",
-    }
+    record["coupling"] = coupling.round(5).tolist()
+    record["sensor_statistics"] = "refitted" if refit_sensor_statistics else "kept"
     if world.coupling is not None:
         record["coupling_correlation"] = coupling_correlation(coupling, world.coupling)
     return mean, std, record
