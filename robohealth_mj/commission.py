@@ -38,22 +38,21 @@ def main(argv: list[str] | None = None) -> None:
     for row in record["settling"]:
         print(f"  after {row['minutes']:>4g} min: {row['relative_error']:.3f} of the final shift")
     settled = record["settled_minutes"]
-    print(
-        f"baseline settled (within {SETTLED:.0%}) after {settled:g} min"
-        if settled is not None
-        else f"baseline not settled within {SETTLED:.0%}: record more healthy running"
-    )
+    if "settling_skipped" in record:
+        print(f"residual baseline not used: {record['settling_skipped']}")
+    elif settled is not None:
+        print(f"baseline settled (within {SETTLED:.0%}) after {settled:g} min")
+    else:
+        print(f"baseline not settled within {SETTLED:.0%}: record more healthy running")
     if "placement" in record:
         p = record["placement"]
-        known = (
-            f", corr. with the arm's placement {p['coupling_correlation']:.2f}"
-            if "coupling_correlation" in p
-            else ""
-        )
-        print(
-            f"placement self-calibration ({p['fit']}): C refitted, reconstruction "
-            f"{p['reconstruction_before']:.3f} -> {p['reconstruction_after']:.3f}{known}"
-        )
+        parts = [f"placement self-calibration ({p['fit']}): C refitted"]
+        if "reconstruction_before" in p:
+            before, after = p["reconstruction_before"], p["reconstruction_after"]
+            parts.append(f"reconstruction {before:.3f} -> {after:.3f}")
+        if "coupling_correlation" in p:
+            parts.append(f"corr. with the arm's placement {p['coupling_correlation']:.2f}")
+        print(", ".join(parts))
     point = record.get("operating_point", {})
     if "healthy_offset" in point:
         print(

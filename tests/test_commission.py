@@ -129,3 +129,20 @@ def test_commissioning_matches_the_healthy_operating_point(deployed, healthy, tm
     session = ort.InferenceSession(record["onnx"], providers=["CPUExecutionProvider"])
     called = session.run(None, {"x": x})[0].argmax(1)
     assert (called == 0).mean() == pytest.approx(point["arm_healthy_rate_after"], abs=tolerance)
+
+
+def test_a_model_that_reads_no_residual_gets_no_settling_table(tiny_corpus, healthy, tmp_path):
+    """A retrofit model reads no tracking error or torque residual on its joints, so how long
+    their baseline took to settle says nothing about it: commissioning says so instead of
+    printing a table (the stock model above, which reads them, gets the table)."""
+    from robohealth_mj.train import run
+
+    cfg = compose_config("train", [
+        f"data.train=[{tiny_corpus}/train_*]", "data.evaluate=null", "trainer.progress=false",
+        "window=8", "sensing=retrofit", "variant=mlp", "model.hidden=8", "trainer.epochs=1",
+    ])  # fmt: skip
+    run(cfg, tmp_path / "run")
+    record = commission(tmp_path / "run" / "best.ckpt", str(healthy["nominal"]), tmp_path / "c",
+                        export=False)  # fmt: skip
+    assert record["settling"] == [] and record["settled_minutes"] is None
+    assert "'retrofit' reads no residual channel" in record["settling_skipped"]

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from robohealth_mj import schema
 from robohealth_mj.data import baseline
 from robohealth_mj.data.arrays import Recording, load_recordings
 from robohealth_mj.data.graphs import GraphSpec, harness_graph
@@ -64,6 +65,15 @@ def settling(x: np.ndarray, tick_hz: float, final: np.ndarray, delta: np.ndarray
     return rows
 
 
+def reads_residuals(graph: GraphSpec) -> bool:
+    """Whether the model reads a residual channel on a joint: only then does the residual
+    baseline, and how many minutes it took to settle, mean anything for it."""
+    if graph.channel_mask is None:
+        return True
+    columns = [schema.feature_index(name) for name in baseline.RESIDUALS]
+    return bool(graph.channel_mask[: schema.N_JOINTS, columns].any())
+
+
 def arm_placement(graph: GraphSpec, placement: dict | None) -> np.ndarray:
     """Where this arm's harness sensors sit: ``placement`` (``coupling_seed`` and
     ``coupling_sensors``, ``coupling_file`` or ``coupling``, as ``graph=harness`` takes them),
@@ -103,7 +113,8 @@ def commission(
     ref_x = ref.x[~ref.active]
     w_ref, w_arm = baseline.fit(ref_x), baseline.fit(arm.x)
     delta = (w_arm - w_ref).astype(np.float32)
-    rows = settling(arm.x, tick_hz, w_arm, delta)
+    trained = graph_from_checkpoint(ckpt)
+    rows = settling(arm.x, tick_hz, w_arm, delta) if reads_residuals(trained) else []
     settled = next(
         (r["minutes"] for k, r in enumerate(rows)
          if all(later["relative_error"] <= SETTLED for later in rows[k:])),
@@ -118,7 +129,12 @@ def commission(
         "settled_minutes": settled,
         "from_checkpoint": str(ckpt_path),
     }
-    graph = replace(graph_from_checkpoint(ckpt), baseline_shift=delta)
+    if not rows and not reads_residuals(trained):
+        record["settling_skipped"] = (
+            f"the sensing profile '{trained.sensing}' reads no residual channel "
+            f"({', '.join(baseline.RESIDUALS)})"
+        )
+    graph = replace(trained, baseline_shift=delta)
     out_dir = Path(out_dir)
     model = model_from_checkpoint(ckpt)
     mean, std = ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()
@@ -133,7 +149,6 @@ def commission(
             f"{ckpt_path}: placement= is for harness models with a coupling head; "
             "this model has no placement to calibrate"
         )
-    trained = graph_from_checkpoint(ckpt)
     offset, record["operating_point"] = match_operating_point(
         model,
         int(ckpt["window"]),
