@@ -161,3 +161,52 @@ def test_a_tiny_campaign_goes_through_the_report_into_every_table(tiny_corpus, t
         "coupling_vs_c0.png",
         "confusion_best_worst_headline.png",
     }
+
+
+def test_the_archive_keeps_a_campaign_that_outlives_its_machine(tmp_path):
+    """``report ROOT --archive A``: the finished runs' records (not their checkpoints) are copied
+    into A, a later campaign's runs join them, a rerun replaces its record, the block times are
+    kept once, and the report is built from everything archived."""
+    from robohealth_mj.report import main
+
+    first, second, archive = tmp_path / "first", tmp_path / "second", tmp_path / "archive"
+    for seed, acc in ((42, 0.8), (43, 0.9)):
+        _run(first, "structural", "stgnn_fixed", seed, acc, acc - 0.1)
+    _run(first, "structural", "mlp", 42, 0.7, 0.2)
+    run_dir = first / "structural" / "full" / "C0"
+    (run_dir / "stgnn_fixed" / "w16" / "seed42" / "model.pt").write_bytes(b"checkpoint")
+    (run_dir / "gat" / "w16" / "seed42").mkdir(parents=True)  # unfinished
+    (first / "blocks.tsv").write_text("matrix\t100\t2\thost\n")
+    main([str(first), "--archive", str(archive), "--out", str(tmp_path / "report")])
+    run42 = archive / "structural" / "full" / "C0" / "stgnn_fixed" / "w16" / "seed42"
+    assert sorted(p.name for p in run42.iterdir()) == [
+        "eval_heldout.json",
+        "eval_probe.json",
+        "train_summary.json",
+    ]
+    assert not (archive / "structural" / "full" / "C0" / "gat").exists()
+
+    # the first machine is gone; a second one reruns seed 43 and adds seed 44
+    import shutil
+
+    shutil.rmtree(first)
+    _run(second, "structural", "stgnn_fixed", 43, 1.0, 0.9)
+    _run(second, "structural", "stgnn_fixed", 44, 1.0, 0.9)
+    (second / "blocks.tsv").write_text("matrix\t100\t2\thost\nmatrix\t50\t2\thost\n")
+    main([str(second), "--archive", str(archive), "--out", str(tmp_path / "report")])
+    text = (tmp_path / "report" / "results.md").read_text()
+    assert "| stgnn_fixed | 16 | 3 | 0.933 ± 0.094 |" in text  # 0.8 kept, 0.9 replaced by 1.0
+    assert "| mlp | 16 | 1 | 0.700 ± 0.000 |" in text
+    assert (archive / "blocks.tsv").read_text() == "matrix\t100\t2\thost\nmatrix\t50\t2\thost\n"
+
+
+def test_report_on_a_missing_directory_is_one_line(tmp_path, capsys):
+    import pytest
+
+    from robohealth_mj.report import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main([str(tmp_path / "nowhere"), "--archive", str(tmp_path / "a")])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "nowhere" in err

@@ -40,7 +40,10 @@ for block in "$@"; do
       done ;;
     severity) timed severity train +experiment=severity ;;
     stock) timed stock train +experiment=stock ;;  # the stock arm (results/stock/)
-    report) $PY -m robohealth_mj.report "$ROOT" ;;
+    # The finished runs' records go into the committed archive (runs/), and the report is built
+    # from it: every run archived so far, from any machine, not only those still in $ROOT.
+    report) $PY -m robohealth_mj.report "$ROOT" --archive results/thesis_physics/runs \
+              --out results/thesis_physics ;;
     *) echo "unknown block: $block" >&2; exit 2 ;;
   esac
 done

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from robohealth_mj.atomic import atomic_write_text
+from robohealth_mj.errors import InputError
 from robohealth_mj.reporting.figures import figures
 from robohealth_mj.reporting.tables import (
     aggregate,
@@ -19,12 +20,14 @@ from robohealth_mj.reporting.tables import (
 __all__ = ["build_report"]
 
 
-def build_report(root: Path) -> tuple[str, list[Path]]:
+def build_report(root: Path, out: Path | None = None) -> tuple[str, list[Path]]:
+    """Tables and figures of every finished run under ``root``, written to ``out`` (default
+    ``root/report``)."""
     runs = collect(root)
     if not runs:
-        raise SystemExit(f"no finished runs (train_summary.json + eval_heldout.json) under {root}")
+        raise InputError(f"no finished runs (train_summary.json + eval_heldout.json) under {root}")
     rows = aggregate(runs)
-    out = root / "report"
+    out = out or root / "report"
     out.mkdir(parents=True, exist_ok=True)
     sections = [markdown(rows), severity_markdown(runs), visibility_markdown(runs),
                 cost_markdown(rows, root)]  # fmt: skip
