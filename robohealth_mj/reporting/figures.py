@@ -10,16 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from robohealth_mj.reporting.tables import REFERENCE
+from robohealth_mj.reporting.tables import DECOMPOSITION, REFERENCE
 from robohealth_mj.schema import FAULT_CLASSES
 
-# The thesis's 2 x 2: (pose kernel, learned residual) -> variant
-DECOMPOSITION = {
-    (False, False): "stgnn_fixed",
-    (True, False): "stgnn_fixed_pose",
-    (False, True): "stgnn_learnable",
-    (True, True): "stgnn_pose_cond",
-}
 HEADLINE = "anomaly_residual"
 
 

@@ -268,6 +268,54 @@ def table8(rows: list[dict[str, Any]]) -> str:
     return "\n".join([*out, ""])
 
 
+# The thesis's 2 x 2 (Q1): (pose kernel, learned residual) -> variant
+DECOMPOSITION = {
+    (False, False): "stgnn_fixed",
+    (True, False): "stgnn_fixed_pose",
+    (False, True): "stgnn_learnable",
+    (True, True): "stgnn_pose_cond",
+}
+
+
+def decomposition_markdown(runs: list[dict[str, Any]]) -> str:
+    """Q1 as paired effects: per seed, the pose kernel's effect (with the pose kernel minus
+    without, averaged over the residual's two levels) and the learned residual's, on held-out
+    accuracy and localisation, mean ± std over the seeds every cell of the 2 x 2 has. Paired,
+    because the four variants of one seed see the same data in the same order: the seed's own
+    luck cancels, which a comparison of means over seeds leaves in."""
+    ref = [r for r in runs if r["setting"] == REFERENCE and r["label"] in DECOMPOSITION.values()]
+    out = []
+    for window in sorted({r["window"] for r in ref}):
+        cell = {(r["label"], r["seed"]): r for r in ref if r["window"] == window}
+        seeds = sorted(
+            seed
+            for seed in {s for _, s in cell}
+            if all((v, seed) in cell for v in DECOMPOSITION.values())
+        )
+        if not seeds:
+            continue
+        if not out:
+            out = _table(
+                "Q1: the pose kernel and the learned residual, paired over seeds (held-out)",
+                ["W", "seeds", "effect", "accuracy", "localisation", "macro-F1"],
+            )
+        for factor, name in ((0, "pose kernel"), (1, "learned residual")):
+            cells = [str(window), str(len(seeds)), name]
+            for metric in ("accuracy", "localisation_accuracy", "macro_f1"):
+                effects = []
+                for seed in seeds:
+                    on = [v for k, v in DECOMPOSITION.items() if k[factor]]
+                    off = [v for k, v in DECOMPOSITION.items() if not k[factor]]
+                    value = {v: _get(cell[v, seed], "heldout", metric) for v in on + off}
+                    effects.append(
+                        np.mean([value[v] for v in on]) - np.mean([value[v] for v in off])
+                    )
+                mean, std, _ = _mean_std(effects)
+                cells.append(f"{mean:+.3f} ± {std:.3f}")
+            out.append("| " + " | ".join(cells) + " |")
+    return "\n".join([*out, ""]) if out else ""
+
+
 def severity_markdown(runs: list[dict[str, Any]]) -> str:
     """The severity head (thesis §4.7): MAE on faulted windows overall, per class and per true
     severity, beside what the same model without the head reaches (its cost)."""
