@@ -63,7 +63,7 @@ def _localisation_bars(plt, save, ref: list[dict]) -> None:
     ax.set_ylim(0, 1)
     ax.set_title("Localisation accuracy by variant (held-out; gbdt in orange)")
     ax.legend(fontsize=8)
-    ax.tick_params(axis="x", labelsize=7)
+    ax.tick_params(axis="x", labelsize=7, labelrotation=35)
     save(fig, "localisation_by_variant.png")
 
 
@@ -136,7 +136,7 @@ def _payload_shift(plt, save, ref: list[dict]) -> None:
     x = np.arange(len(shift))
     ax.bar(x - 0.2, [r["heldout.accuracy"][0] for r in shift], 0.4, label="held-out")
     ax.bar(x + 0.2, [r["probe.accuracy"][0] for r in shift], 0.4, label="payload 2.2 probe")
-    ax.set_xticks(x, [_label(r) for r in shift], fontsize=7)
+    ax.set_xticks(x, [_label(r) for r in shift], fontsize=7, rotation=35)
     ax.set_ylim(0, 1)
     ax.set_title("Classification accuracy: payload shift")
     ax.legend(fontsize=8)
