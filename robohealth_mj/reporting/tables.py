@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj.models import VARIANTS
+from robohealth_mj.reporting.archive import SUMMARY, finished_runs
 from robohealth_mj.schema import FAULT_CLASSES
 
 VARIANT_ORDER = VARIANTS
@@ -43,9 +44,8 @@ def model_label(summary: dict[str, Any]) -> str:
 def collect(root: Path) -> list[dict[str, Any]]:
     """One row per finished run (a ``train_summary.json`` with an ``eval_heldout.json``)."""
     runs = []
-    for summary_path in sorted(root.rglob("train_summary.json")):
-        run_dir = summary_path.parent
-        summary = json.loads(summary_path.read_text())
+    for run_dir in finished_runs(root):
+        summary = json.loads((run_dir / SUMMARY).read_text())
         row = {
             "dir": str(run_dir),
             "variant": summary["variant"],
@@ -71,8 +71,7 @@ def collect(root: Path) -> list[dict[str, Any]]:
                 if "coupling_correlation" in result:
                     row["coupling_correlation"] = result["coupling_correlation"]
                     row["coupling"] = result["coupling"]
-        if "heldout" in row:
-            runs.append(row)
+        runs.append(row)
     return runs
 
 
@@ -300,16 +299,15 @@ def decomposition_markdown(runs: list[dict[str, Any]]) -> str:
                 ["W", "seeds", "effect", "accuracy", "localisation", "macro-F1"],
             )
         for factor, name in ((0, "pose kernel"), (1, "learned residual")):
+            on = [v for k, v in DECOMPOSITION.items() if k[factor]]
+            off = [v for k, v in DECOMPOSITION.items() if not k[factor]]
             cells = [str(window), str(len(seeds)), name]
             for metric in ("accuracy", "localisation_accuracy", "macro_f1"):
-                effects = []
-                for seed in seeds:
-                    on = [v for k, v in DECOMPOSITION.items() if k[factor]]
-                    off = [v for k, v in DECOMPOSITION.items() if not k[factor]]
-                    value = {v: _get(cell[v, seed], "heldout", metric) for v in on + off}
-                    effects.append(
-                        np.mean([value[v] for v in on]) - np.mean([value[v] for v in off])
-                    )
+                effects = [
+                    np.mean([_get(cell[v, seed], "heldout", metric) for v in on])
+                    - np.mean([_get(cell[v, seed], "heldout", metric) for v in off])
+                    for seed in seeds
+                ]
                 mean, std, _ = _mean_std(effects)
                 cells.append(f"{mean:+.3f} ± {std:.3f}")
             out.append("| " + " | ".join(cells) + " |")

@@ -114,7 +114,8 @@ def commission(
     w_ref, w_arm = baseline.fit(ref_x), baseline.fit(arm.x)
     delta = (w_arm - w_ref).astype(np.float32)
     trained = graph_from_checkpoint(ckpt)
-    rows = settling(arm.x, tick_hz, w_arm, delta) if reads_residuals(trained) else []
+    reads = reads_residuals(trained)
+    rows = settling(arm.x, tick_hz, w_arm, delta) if reads else []
     settled = next(
         (r["minutes"] for k, r in enumerate(rows)
          if all(later["relative_error"] <= SETTLED for later in rows[k:])),
@@ -129,7 +130,7 @@ def commission(
         "settled_minutes": settled,
         "from_checkpoint": str(ckpt_path),
     }
-    if not rows and not reads_residuals(trained):
+    if not reads:
         record["settling_skipped"] = (
             f"the sensing profile '{trained.sensing}' reads no residual channel "
             f"({', '.join(baseline.RESIDUALS)})"
