@@ -20,8 +20,9 @@ def _run(
     acc: float,
     loc: float,
     corr: float | None = None,
+    anomaly_scores: str | None = None,
 ) -> None:
-    d = root / graph / "full" / "C0" / variant / "w16" / f"seed{seed}"
+    d = root / graph / "full" / "C0" / f"{variant}{anomaly_scores or ''}" / "w16" / f"seed{seed}"
     d.mkdir(parents=True)
     (d / "train_summary.json").write_text(
         json.dumps(
@@ -32,6 +33,7 @@ def _run(
                 "graph": graph,
                 "gamma": None,
                 "best_epoch": 3,
+                "anomaly_scores": anomaly_scores,
             }
         )
     )
@@ -232,3 +234,24 @@ def test_q1_effects_are_paired_over_the_seeds_every_cell_has(tmp_path):
         line for line in text[text.index(section) :].splitlines() if "| learned residual |" in line
     )
     assert "| -0.020 ± 0.000 | -0.020 ± 0.000 |" in residual  # accuracy, localisation
+
+
+def test_q2_differences_are_paired_per_seed_and_per_harness_setting(tmp_path):
+    """The coupling head minus each model under the harness, per seed: seed 44 lifts `gbdt`
+    alone (no head run to pair it with), so a difference of means would hide the head's lead."""
+    for seed, loc in ((42, 0.80), (43, 0.90)):
+        _run(tmp_path, "harness", "anomaly_residual", seed, 0.8, loc, 0.9, anomaly_scores="energy")
+    for seed, loc in ((42, 0.75), (43, 0.80), (44, 0.99)):
+        _run(tmp_path, "harness", "gbdt", seed, 0.7, loc)
+    _run(tmp_path, "harness", "stgnn_fixed", 42, 0.8, 0.70)
+    _run(tmp_path, "structural", "gbdt", 42, 0.8, 0.10)  # not a harness run: not compared
+    text, _ = build_report(tmp_path)
+    section = "### Q2: the coupling head"
+    rows = [
+        line.split(" | ") for line in text[text.index(section) :].split("\n\n")[1].splitlines()[2:]
+    ]
+    assert [r[:5] for r in rows] == [
+        ["| harness/full/C0", "16", "2", "gbdt", "+0.075 ± 0.025"],
+        ["| harness/full/C0", "16", "1", "stgnn_fixed", "+0.100 ± 0.000"],
+    ]
+    assert rows[0][5] == "+0.100 ± 0.000"  # accuracy 0.8 - 0.7 on both seeds

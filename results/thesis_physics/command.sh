@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The thesis's experiment on physics (campaign issue), one block per argument, all into
 # outputs/thesis_physics (a finished run is skipped, so any block resumes after interruption):
-#   bash results/thesis_physics/command.sh corpus matrix matrix_w32 windows harness placements severity stock report
+#   bash results/thesis_physics/command.sh corpus matrix matrix_w32 windows harness retrofit_known placements severity stock report
+# (harness = harness_fixed + harness_coupling, either half runnable alone)
 # JOBS parallel runs of one thread each (default 2, for 2 cores); TRAIN_ARGS adds overrides to every
 # run (e.g. "trainer.device=cuda variant=mlp,gat"); CORPUS names the corpus directory.
 set -euo pipefail
@@ -31,6 +32,8 @@ for block in "$@"; do
     windows) timed windows train +experiment=window_ablation ;;
     harness) timed harness train +experiment=harness
              timed harness_coupling train +experiment=harness_coupling ;;
+    harness_fixed) timed harness train +experiment=harness ;;  # the harness's first half alone
+    harness_coupling) timed harness_coupling train +experiment=harness_coupling ;;  # second half
     placements)
       for p in 1:3 2:4 3:6 4:8 5:4; do
         set -- graph.coupling_seed="${p%:*}" graph.coupling_sensors="${p#*:}"
@@ -38,6 +41,8 @@ for block in "$@"; do
         timed "placement_${p%:*}_coupling" train +experiment=placements "$@" \
           variant=anomaly_residual model.anomaly_scores=energy
       done ;;
+    retrofit_known)  # the retrofit profile with the placement known (structural graph): its ceiling
+      timed retrofit_known train window=32 sensing=retrofit variant=gbdt,anomaly_residual seed=42 ;;
     severity) timed severity train +experiment=severity ;;
     stock) timed stock train +experiment=stock ;;  # the stock arm (results/stock/)
     # The finished runs' records go into the committed archive (runs/), and the report is built

@@ -11,6 +11,7 @@ from robohealth_mj.reporting.tables import (
     aggregate,
     collect,
     cost_markdown,
+    coupling_markdown,
     decomposition_markdown,
     markdown,
     severity_markdown,
@@ -30,8 +31,14 @@ def build_report(root: Path, out: Path | None = None) -> tuple[str, list[Path]]:
     rows = aggregate(runs)
     out = out or root / "report"
     out.mkdir(parents=True, exist_ok=True)
-    sections = [markdown(rows), decomposition_markdown(runs), severity_markdown(runs),
-                visibility_markdown(runs), cost_markdown(rows, root)]  # fmt: skip
+    sections = [
+        markdown(rows),
+        decomposition_markdown(runs),
+        coupling_markdown(runs),
+        severity_markdown(runs),
+        visibility_markdown(runs),
+        cost_markdown(rows, root),
+    ]
     text = "\n".join(s for s in sections if s)
     atomic_write_text(
         out / "results.md",

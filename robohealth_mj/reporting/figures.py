@@ -224,7 +224,8 @@ def _harness(plt, save, harness: list[dict]) -> None:
     ax.set_ylim(0, 1)
     ax.set_ylabel("held-out localisation")
     ax.set_title("Unknown placement: localisation by placement, model and sensing profile")
-    ax.legend(fontsize=6, ncol=2)
+    # below the axes: with up to 12 series a legend inside would hide the bars' tops
+    ax.legend(fontsize=6, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.12))
     save(fig, "harness_localisation.png")
 
 

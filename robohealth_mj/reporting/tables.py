@@ -314,6 +314,50 @@ def decomposition_markdown(runs: list[dict[str, Any]]) -> str:
     return "\n".join([*out, ""]) if out else ""
 
 
+# Q2's model: the learned joint-sensor coupling with sign-pinned sensor scores
+COUPLING_HEAD = "anomaly_residual+energy"
+
+
+def coupling_markdown(runs: list[dict[str, Any]]) -> str:
+    """Q2 as paired differences: under each harness setting (sensing profile, placement) and
+    window, the coupling head minus every other model run there, per seed, on held-out
+    localisation and accuracy; mean ± std over the seeds both have. Paired for Q1's reason."""
+    harness = [r for r in runs if r["graph"] == "harness"]
+    out: list[str] = []
+    for setting, window in dict.fromkeys((r["setting"], r["window"]) for r in harness):
+        cell = {
+            (r["label"], r["seed"]): r
+            for r in harness
+            if (r["setting"], r["window"]) == (setting, window)
+        }
+        head_seeds = {seed for label, seed in cell if label == COUPLING_HEAD}
+        others = sorted(
+            {label for label, _ in cell if label != COUPLING_HEAD},
+            key=lambda label: (_rank(label), label),
+        )
+        for other in others:
+            seeds = sorted(head_seeds & {seed for label, seed in cell if label == other})
+            if not seeds:
+                continue
+            if not out:
+                out = _table(
+                    f"Q2: the coupling head ({COUPLING_HEAD}) minus each model under the "
+                    "harness, paired over seeds (held-out)",
+                    ["setting", "W", "seeds", "minus", "localisation", "accuracy", "macro-F1"],
+                )
+            cells = [setting, str(window), str(len(seeds)), other]
+            for metric in ("localisation_accuracy", "accuracy", "macro_f1"):
+                diffs = [
+                    _get(cell[COUPLING_HEAD, seed], "heldout", metric)
+                    - _get(cell[other, seed], "heldout", metric)
+                    for seed in seeds
+                ]
+                mean, std, _ = _mean_std(diffs)
+                cells.append(f"{mean:+.3f} ± {std:.3f}")
+            out.append("| " + " | ".join(cells) + " |")
+    return "\n".join([*out, ""]) if out else ""
+
+
 def severity_markdown(runs: list[dict[str, Any]]) -> str:
     """The severity head (thesis §4.7): MAE on faulted windows overall, per class and per true
     severity, beside what the same model without the head reaches (its cost)."""
