@@ -321,7 +321,8 @@ COUPLING_HEAD = "anomaly_residual+energy"
 def coupling_markdown(runs: list[dict[str, Any]]) -> str:
     """Q2 as paired differences: under each harness setting (sensing profile, placement) and
     window, the coupling head minus every other model run there, per seed, on held-out
-    localisation and accuracy; mean ± std over the seeds both have. Paired for Q1's reason."""
+    localisation, accuracy and macro-F1; mean ± std over the seeds both have. Paired for Q1's
+    reason: a seed's luck is shared by the models of that seed."""
     harness = [r for r in runs if r["graph"] == "harness"]
     out: list[str] = []
     for setting, window in dict.fromkeys((r["setting"], r["window"]) for r in harness):
