@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +19,7 @@ from robohealth_mj.learn.checkpoint import (
 )
 from robohealth_mj.learn.data import WindowTensors
 from robohealth_mj.learn.metrics import flat_rows
-from robohealth_mj.learn.predict import predict
+from robohealth_mj.learn.predict import Predictions, predict
 from robohealth_mj.learn.trainer import (
     coupling_report,
     expand_paths,
@@ -28,10 +29,22 @@ from robohealth_mj.learn.trainer import (
 )
 
 
-def evaluate_checkpoint(
-    ckpt_path: Path | str, data: list[str] | str, device: str = "auto"
-) -> dict[str, Any]:
-    """Rebuild the exact model from its checkpoint and score it on every window of ``data``."""
+@dataclass
+class Scored:
+    """A checkpoint's model rebuilt and run over every window of some recordings."""
+
+    ckpt: dict[str, Any]
+    graph: Any  # GraphSpec
+    files: list[Path]
+    rec: Any  # the recordings, relabelled for the checkpoint's profile
+    windows: Any
+    model: Any
+    predictions: Predictions
+
+
+def score_checkpoint(ckpt_path: Path | str, data: list[str] | str, device: str = "auto") -> Scored:
+    """Rebuild the exact model from its checkpoint and predict every window of ``data`` (what
+    evaluation and any per-window measurement share)."""
     ckpt = load_checkpoint(ckpt_path)
     files = expand_paths(data)
     check_recordings(ckpt, files)
@@ -43,7 +56,17 @@ def evaluate_checkpoint(
     )
     model = model_from_checkpoint(ckpt).to(dev)
     windows = make_windows(rec, int(ckpt["window"]), ckpt["config"].get("stride"))
-    metrics = metrics_of(predict(model, tensors, windows), target_joint_moved(rec, windows))
+    return Scored(ckpt, graph, files, rec, windows, model, predict(model, tensors, windows))
+
+
+def evaluate_checkpoint(
+    ckpt_path: Path | str, data: list[str] | str, device: str = "auto"
+) -> dict[str, Any]:
+    """Rebuild the exact model from its checkpoint and score it on every window of ``data``."""
+    scored = score_checkpoint(ckpt_path, data, device)
+    ckpt, graph, rec, model = scored.ckpt, scored.graph, scored.rec, scored.model
+    files = scored.files
+    metrics = metrics_of(scored.predictions, target_joint_moved(rec, scored.windows))
     return {
         "checkpoint": str(ckpt_path),
         "variant": ckpt["variant"],

@@ -12,27 +12,12 @@ import sys
 import numpy as np
 import torch
 
-from robohealth_mj.data.arrays import load_recordings
-from robohealth_mj.data.windows import make_windows
-from robohealth_mj.learn.checkpoint import (
-    graph_from_checkpoint,
-    load_checkpoint,
-    model_from_checkpoint,
-)
-from robohealth_mj.learn.data import WindowTensors
-from robohealth_mj.learn.predict import predict
-from robohealth_mj.learn.trainer import expand_paths
+from robohealth_mj.learn.evaluation import score_checkpoint
 from robohealth_mj.schema import FAULT_CLASSES
 
 
 def strata(heldout: str, ckpt_path: str) -> list[str]:
-    ckpt = load_checkpoint(ckpt_path)
-    graph = graph_from_checkpoint(ckpt)
-    rec = graph.relabel(load_recordings(expand_paths(heldout)))
-    mean, std = ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()
-    tensors = WindowTensors(graph.transform(rec.x), rec, mean, std, torch.device("cpu"))
-    windows = make_windows(rec, int(ckpt["window"]), ckpt["config"].get("stride"))
-    p = predict(model_from_checkpoint(ckpt), tensors, windows)
+    p = score_checkpoint(ckpt_path, heldout, "cpu").predictions
     if p.severity is None:
         raise SystemExit(f"{ckpt_path}: the model has no severity head")
     faulted = p.active.astype(bool)
