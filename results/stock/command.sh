@@ -8,6 +8,12 @@ CORPUS=$CORPUS bash results/thesis_physics/command.sh stock matrix_w32   # 3 see
 $PY results/stock/compare.py                                        # -> stock_vs_full.md
 $PY results/stock/unseen_arms.py "$CORPUS"                          # -> unseen_arms.md
 bash results/stock/alarms.sh "$CORPUS" && $PY results/stock/unseen_arms.py "$CORPUS"
+# An unseen program: ten minutes of its healthy running to commission on, then the table.
+$PY -m robohealth_mj.record seed=950 faults=none session.duration_s=600 \
+  'curriculum.families=[pick_place]' 'curriculum.speed_scales=[0.6,1.0,1.5]' \
+  'curriculum.payload_scales=[0.5,1.0,1.6]' session.progress=false \
+  session.out_dir="$CORPUS/healthy_program_seed950"
+$PY results/stock/unseen_program.py "$CORPUS"                       # -> unseen_program.md
 # Placement self-calibration (retrofit harness, W = 32, seed 42): a model trained under 256 drawn
 # placements, models trained on each test placement (the references), then commissioning.
 H="graph=harness sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy window=32"

@@ -100,7 +100,7 @@ def program_lines(rows: dict) -> list[str]:
         "| variant | seeds | held-out acc. / loc. | nominal-arm probes | unseen program |",
         "|---|---|---|---|---|",
     ]
-    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: v != "gbdt"):
+    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: (v != "gbdt", v)):
         group = [r for r in rows.values() if r["variant"] == variant and "program" in r]
         if not group:
             continue
@@ -125,7 +125,7 @@ def alarm_lines() -> list[str]:
     lines = [
         "",
         "On-line, `stgnn_fixed` seed 42 exported to ONNX, the monitor's default alarm policy",
-        "(`bash results/stock/alarms.sh outputs/corpus/deconf`), summed over the three sessions:",
+        f"(`bash results/stock/alarms.sh {CORPUS}`), summed over the three sessions:",
         "",
         "| arm | episodes detected | right class and joint at the rise | false alarms | "
         "healthy hours | false alarms / h | on-line accuracy |",
@@ -158,7 +158,7 @@ def table(rows: dict) -> str:
     lines = [
         "# Unseen arms, before and after commissioning (stock profile, W = 32)",
         "",
-        "Made by `.venv/bin/python results/stock/unseen_arms.py outputs/corpus/deconf` on the",
+        f"Made by `.venv/bin/python results/stock/unseen_arms.py {CORPUS}` on the",
         "2-core machine. Three probe sessions (seeds 910-912), each run by its own arm drawn from",
         "its seed (drive friction and damping ±30 %, link masses ±15 %, drive stiffness and rotor",
         "inertia ±10 %; the controller keeps the nominal model); each model commissioned per arm",
@@ -169,7 +169,7 @@ def table(rows: dict) -> str:
         " after | nominal arm loc. | unseen loc. before | after | baseline settled (min) |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: v != "gbdt"):
+    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: (v != "gbdt", v)):
         group = [r for r in rows.values() if r["variant"] == variant]
         arms = [a for r in group for a in r["arms"].values()]
         settled = [a["settled_minutes"] for a in arms if a["settled_minutes"] is not None]
@@ -194,7 +194,7 @@ def table(rows: dict) -> str:
         "| variant | set | " + " | ".join(classes) + " |",
         "|---|---|" + "---|" * len(classes),
     ]
-    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: v != "gbdt"):
+    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: (v != "gbdt", v)):
         group = [r for r in rows.values() if r["variant"] == variant]
         arms = [a for r in group for a in r["arms"].values()]
         nominal = [n for r in group for n in r["nominal"].values()]

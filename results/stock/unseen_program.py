@@ -3,7 +3,9 @@
 that program's healthy running (seed 950), beside the held-out session.
 
     .venv/bin/python -m robohealth_mj.record seed=950 faults=none session.duration_s=600 \\
-        'curriculum.families=[pick_place]' session.out_dir=CORPUS/healthy_program_seed950 ...
+        'curriculum.families=[pick_place]' 'curriculum.speed_scales=[0.6,1.0,1.5]' \\
+        'curriculum.payload_scales=[0.5,1.0,1.6]' session.progress=false \\
+        session.out_dir=CORPUS/healthy_program_seed950
     .venv/bin/python results/stock/unseen_program.py [CORPUS]    # writes unseen_program.md here
 """
 
@@ -51,7 +53,7 @@ def main() -> None:
     lines = [
         "# An unseen program (stock profile, W = 32)",
         "",
-        "Made by `.venv/bin/python results/stock/unseen_program.py outputs/corpus/deconf`:",
+        f"Made by `.venv/bin/python results/stock/unseen_program.py {CORPUS}`:",
         "two sessions of pick-and-place and palletising cycles (point-to-point moves with dwells;",
         "no training session ran them), nominal arm, as trained and after commissioning on ten",
         "minutes of this program's healthy running. Mean ± std over three seeds; `moving`:",
@@ -62,7 +64,7 @@ def main() -> None:
         + " |",
         "|---|---|---|---|---|" + "---|" * len(CLASSES),
     ]
-    for variant in sorted({r["variant"] for r in rows}, key=lambda v: v != "gbdt"):
+    for variant in sorted({r["variant"] for r in rows}, key=lambda v: (v != "gbdt", v)):
         group = [r for r in rows if r["variant"] == variant]
         for key, name in (("heldout", "held-out"), ("before", "program"),
                           ("after", "program, commissioned")):  # fmt: skip
