@@ -26,6 +26,11 @@ PROGRAM = "probe_unseen_program"
 KEYS = ("accuracy", "macro_f1", "localisation_accuracy")
 
 
+def variants(rows: dict) -> list[str]:
+    """The variants in table order: the `gbdt` reference first, then by name."""
+    return sorted({r["variant"] for r in rows.values()}, key=lambda v: (v != "gbdt", v))
+
+
 def scores(metrics: dict) -> dict:
     out = {k: metrics[k] for k in KEYS}
     out["recall"] = {c: v["recall"] for c, v in metrics["per_class"].items() if v["support"]}
@@ -100,7 +105,7 @@ def program_lines(rows: dict) -> list[str]:
         "| variant | seeds | held-out acc. / loc. | nominal-arm probes | unseen program |",
         "|---|---|---|---|---|",
     ]
-    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: (v != "gbdt", v)):
+    for variant in variants(rows):
         group = [r for r in rows.values() if r["variant"] == variant and "program" in r]
         if not group:
             continue
@@ -169,7 +174,7 @@ def table(rows: dict) -> str:
         " after | nominal arm loc. | unseen loc. before | after | baseline settled (min) |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: (v != "gbdt", v)):
+    for variant in variants(rows):
         group = [r for r in rows.values() if r["variant"] == variant]
         arms = [a for r in group for a in r["arms"].values()]
         settled = [a["settled_minutes"] for a in arms if a["settled_minutes"] is not None]
@@ -194,7 +199,7 @@ def table(rows: dict) -> str:
         "| variant | set | " + " | ".join(classes) + " |",
         "|---|---|" + "---|" * len(classes),
     ]
-    for variant in sorted({r["variant"] for r in rows.values()}, key=lambda v: (v != "gbdt", v)):
+    for variant in variants(rows):
         group = [r for r in rows.values() if r["variant"] == variant]
         arms = [a for r in group for a in r["arms"].values()]
         nominal = [n for r in group for n in r["nominal"].values()]

@@ -8,6 +8,7 @@ import csv
 import io
 import json
 from collections import defaultdict
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -267,6 +268,18 @@ def table8(rows: list[dict[str, Any]]) -> str:
     return "\n".join([*out, ""])
 
 
+def _paired_cells(
+    effect: Callable[[int, str], float], seeds: list[int], metrics: tuple[str, ...]
+) -> list[str]:
+    """One ``mean ± std`` cell per metric of a per-seed difference ``effect(seed, metric)``:
+    the paired comparison both research questions' tables make."""
+    cells = []
+    for metric in metrics:
+        mean, std, _ = _mean_std([effect(seed, metric) for seed in seeds])
+        cells.append(f"{mean:+.3f} ± {std:.3f}")
+    return cells
+
+
 # The thesis's 2 x 2 (Q1): (pose kernel, learned residual) -> variant
 DECOMPOSITION = {
     (False, False): "stgnn_fixed",
@@ -301,15 +314,15 @@ def decomposition_markdown(runs: list[dict[str, Any]]) -> str:
         for factor, name in ((0, "pose kernel"), (1, "learned residual")):
             on = [v for k, v in DECOMPOSITION.items() if k[factor]]
             off = [v for k, v in DECOMPOSITION.items() if not k[factor]]
-            cells = [str(window), str(len(seeds)), name]
-            for metric in ("accuracy", "localisation_accuracy", "macro_f1"):
-                effects = [
+
+            def effect(seed: int, metric: str, cell=cell, on=on, off=off) -> float:
+                return float(
                     np.mean([_get(cell[v, seed], "heldout", metric) for v in on])
                     - np.mean([_get(cell[v, seed], "heldout", metric) for v in off])
-                    for seed in seeds
-                ]
-                mean, std, _ = _mean_std(effects)
-                cells.append(f"{mean:+.3f} ± {std:.3f}")
+                )
+
+            cells = [str(window), str(len(seeds)), name]
+            cells += _paired_cells(effect, seeds, ("accuracy", "localisation_accuracy", "macro_f1"))
             out.append("| " + " | ".join(cells) + " |")
     return "\n".join([*out, ""]) if out else ""
 
@@ -346,15 +359,16 @@ def coupling_markdown(runs: list[dict[str, Any]]) -> str:
                     "harness, paired over seeds (held-out)",
                     ["setting", "W", "seeds", "minus", "localisation", "accuracy", "macro-F1"],
                 )
+
+            def difference(seed: int, metric: str, cell=cell, other=other) -> float:
+                return _get(cell[COUPLING_HEAD, seed], "heldout", metric) - _get(
+                    cell[other, seed], "heldout", metric
+                )
+
             cells = [setting, str(window), str(len(seeds)), other]
-            for metric in ("localisation_accuracy", "accuracy", "macro_f1"):
-                diffs = [
-                    _get(cell[COUPLING_HEAD, seed], "heldout", metric)
-                    - _get(cell[other, seed], "heldout", metric)
-                    for seed in seeds
-                ]
-                mean, std, _ = _mean_std(diffs)
-                cells.append(f"{mean:+.3f} ± {std:.3f}")
+            cells += _paired_cells(
+                difference, seeds, ("localisation_accuracy", "accuracy", "macro_f1")
+            )
             out.append("| " + " | ".join(cells) + " |")
     return "\n".join([*out, ""]) if out else ""
 
