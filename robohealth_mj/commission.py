@@ -32,7 +32,8 @@ def main(argv: list[str] | None = None) -> None:
         given = OmegaConf.to_container(cfg.placement) if cfg.get("placement") else {}
         placement = {k: v for k, v in given.items() if v is not None} or None
         record = commission(cfg.model, healthy, out, cfg.reference, cfg.export, placement=placement,
-                            placement_fit=cfg.placement_fit)  # fmt: skip
+                            placement_fit=cfg.placement_fit,
+                            operating_point=cfg.operating_point)  # fmt: skip
         atomic_write_json(out / "commissioning.json", record)
     print(f"{record['healthy_minutes']:g} healthy minutes -> {record['checkpoint']}")
     for row in record["settling"]:
@@ -53,12 +54,15 @@ def main(argv: list[str] | None = None) -> None:
         if "coupling_correlation" in p:
             parts.append(f"corr. with the arm's placement {p['coupling_correlation']:.2f}")
         print(", ".join(parts))
+        train = f"python -m robohealth_mj.train graph=harness graph.coupling_file={p['file']}"
+        print(f"placement found -> {p['file']} (a model trained on it: {train} ...)")
     point = record.get("operating_point", {})
-    if "healthy_offset" in point:
+    if "class_offset" in point:
         print(
-            f"healthy operating point: this arm's healthy windows called healthy "
-            f"{point['arm_healthy_rate_before']:.3f} -> {point['arm_healthy_rate_after']:.3f} "
-            f"(validation: {point['validation_healthy_rate']:.3f})"
+            f"healthy operating point ({point['recipe']}): this arm's healthy windows called "
+            f"healthy {point['arm_healthy_rate_before']:.3f} -> "
+            f"{point['arm_healthy_rate_after']:.3f} (validation: "
+            f"{point['validation_healthy_rate']:.3f})"
         )
     if "onnx" in record:
         print(f"exported -> {record['onnx']}")

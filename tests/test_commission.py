@@ -20,6 +20,7 @@ from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoin
 from robohealth_mj.recorder import record_session
 from robohealth_mj.runtime.commission import commission
 from robohealth_mj.runtime.export import read_metadata
+from robohealth_mj.runtime.operating_point import per_class_offset
 
 J = schema.N_JOINTS
 ELBOW, RESIDUAL = 2, schema.feature_index("effort_residual")
@@ -108,12 +109,13 @@ def test_commission_refuses_faulted_data_in_one_line(stock_deployed, capsys):
 
 
 def test_commissioning_matches_the_healthy_operating_point(deployed, healthy, tmp_path):
-    """On a program unlike its training sweeps, the arm's healthy windows are called healthy at
-    the rate the model calls its validation session's, and the exported model decides with
-    the raised healthy logit."""
+    """The ``healthy`` recipe: on a program unlike its training sweeps, the arm's healthy
+    windows are called healthy at the rate the model calls its validation session's, and the
+    exported model decides with the raised healthy logit."""
     ckpt = deployed["structural_ckpt"]
     reference = str(Path(deployed["root"]) / "train_*")
-    record = commission(ckpt, str(healthy["program"]), tmp_path, reference)
+    record = commission(ckpt, str(healthy["program"]), tmp_path, reference,
+                        operating_point="healthy")  # fmt: skip
     point = record["operating_point"]
     assert point["validation_windows"] > 0 and point["arm_windows"] > 0
     tolerance = 1.0 / point["arm_windows"]
@@ -129,6 +131,60 @@ def test_commissioning_matches_the_healthy_operating_point(deployed, healthy, tm
     session = ort.InferenceSession(record["onnx"], providers=["CPUExecutionProvider"])
     called = session.run(None, {"x": x})[0].argmax(1)
     assert (called == 0).mean() == pytest.approx(point["arm_healthy_rate_after"], abs=tolerance)
+
+
+def test_per_class_matching_lowers_only_what_healthy_running_is_mistaken_for():
+    """Healthy running called jam far more often than in validation: jam's logit is lowered
+    just enough to bring that rate back, the windows it hands to friction lower friction in
+    turn, and a class healthy running is not mistaken for keeps its logit, so a clear
+    backlash window is still called backlash."""
+    rng = np.random.default_rng(0)
+    validation = np.zeros((200, 5), np.float32)
+    validation[:, 0] = 1.0
+    validation[:4, 3] = 2.0  # 2 % of validation's healthy windows called jam
+    arm = np.zeros((200, 5), np.float32)
+    arm[:, 0] = 1.0
+    arm[:60, 3] = 1.5 + rng.uniform(0.0, 1.0, 60)  # 30 % called jam ...
+    arm[:20, 2] = 1.4  # ... a third of them with friction next
+    offset = per_class_offset(validation, arm)
+    assert offset[0] == 0.0 and offset[1] == 0.0 and offset[4] == 0.0
+    assert offset[3] < 0.0 and offset[2] < 0.0
+    called = (arm + offset).argmax(1)
+    assert (called == 3).mean() == pytest.approx(0.02, abs=1 / 200)  # no lower than needed
+    assert (called == 2).mean() <= 1 / 200  # validation never calls friction: one window
+    backlash = np.array([[1.0, 1.2, 0.0, 0.0, 0.0]], np.float32)
+    assert (backlash + offset).argmax(1)[0] == 1
+
+
+def test_commissioning_matches_each_fault_class_by_default(deployed, healthy, tmp_path):
+    """The default ``per_class`` recipe: the program's healthy windows are called each fault
+    class no more often than the validation session's are, only fault logits move (down),
+    and the exported model decides with them."""
+    ckpt = deployed["structural_ckpt"]
+    reference = str(Path(deployed["root"]) / "train_*")
+    record = commission(ckpt, str(healthy["program"]), tmp_path, reference)
+    point = record["operating_point"]
+    assert point["recipe"] == "per_class"
+    offset = np.asarray(point["class_offset"])
+    assert offset[0] == 0.0 and (offset <= 0.0).all() and (offset < 0.0).any()
+    tolerance = 1.0 / point["arm_windows"]
+    assert point["arm_healthy_rate_after"] > point["arm_healthy_rate_before"] + 5 * tolerance
+    rec = load_recordings([healthy["program"] / "graphs.jsonl"])
+    windows = make_windows(rec, int(load_checkpoint(ckpt)["window"]))
+    x = np.stack([rec.x[s : s + windows.window] for s in windows.start])
+    session = ort.InferenceSession(record["onnx"], providers=["CPUExecutionProvider"])
+    called = session.run(None, {"x": x})[0].argmax(1)
+    assert (called == 0).mean() == pytest.approx(point["arm_healthy_rate_after"], abs=tolerance)
+
+
+def test_an_unknown_operating_point_recipe_is_one_line(stock_deployed, healthy, capsys):
+    with pytest.raises(SystemExit) as done:
+        commission_main([f"model={stock_deployed['ckpt']}", f"healthy={healthy['nominal']}",
+                         "operating_point=median", "export=false",
+                         f"out={healthy['nominal'].parent / 'unknown_recipe'}"])  # fmt: skip
+    err = capsys.readouterr().err.strip()
+    assert done.value.code == 2 and "\n" not in err
+    assert "operating_point must be one of ('per_class', 'healthy'), got 'median'" in err
 
 
 def test_a_model_that_reads_no_residual_gets_no_settling_table(tiny_corpus, healthy, tmp_path):

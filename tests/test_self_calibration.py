@@ -16,7 +16,7 @@ from robohealth_mj import schema
 from robohealth_mj.commission import main as commission_main
 from robohealth_mj.config import compose_config
 from robohealth_mj.data.arrays import load_recordings
-from robohealth_mj.data.graphs import DEFAULT_C0, coupling_correlation, harness_graph
+from robohealth_mj.data.graphs import DEFAULT_C0, coupling_correlation, harness_graph, load_coupling
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
 from robohealth_mj.learn.checkpoint import model_from_checkpoint as build
 from robohealth_mj.learn.placements import (
@@ -178,6 +178,9 @@ def test_commissioning_refits_the_coupling_to_the_arms_placement(drawn, healthy_
     arm = load_recordings([healthy_arm / "graphs.jsonl"])
     want = np.maximum(motion_estimate(reference, arm, world), 1e-2)  # softplus's floor
     np.testing.assert_allclose(refitted, want, rtol=1e-3, atol=1e-4)
+    # the placement found is written as a placement file a model can be trained on
+    assert found["file"] == str(tmp_path / "placement.json")
+    np.testing.assert_allclose(load_coupling(found["file"]), want, rtol=1e-3, atol=1e-4)
     assert found["coupling_correlation"] == pytest.approx(
         coupling_correlation(refitted, truth), abs=1e-3
     )

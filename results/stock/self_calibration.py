@@ -2,16 +2,19 @@
 ten healthy minutes of an arm whose sensors sit in a placement it never saw, against a model
 trained on that placement. Retrofit sensing, W = 32, held-out session.
 
-    .venv/bin/python results/stock/self_calibration.py POOL_CKPT [SINGLE_CKPT] \
-        > results/stock/self_calibration.md
+    CORPUS=outputs/corpus/standard .venv/bin/python results/stock/self_calibration.py \
+        POOL_CKPT [SINGLE_CKPT] > results/stock/self_calibration.md
 
 POOL_CKPT: trained with ``trainer.placements=256`` (command in results/stock/command.sh);
 SINGLE_CKPT: the campaign's model trained on C0 alone (for contrast). Trained-on-placement
 references: the campaign's runs under ``outputs/thesis_physics/harness/retrofit/<placement>``.
+CORPUS (default ``outputs/corpus/standard``) holds the held-out session and ten healthy minutes
+of the nominal arm (``healthy_nominal_seed940``, recorded by ``results/stock/command.sh``).
 """
 
 from __future__ import annotations
 
+import os
 import sys
 import tempfile
 from dataclasses import replace
@@ -32,7 +35,7 @@ from robohealth_mj.learn.predict import predict
 from robohealth_mj.learn.trainer import metrics_of
 from robohealth_mj.runtime.commission import commission
 
-CORPUS = "outputs/corpus/deconf"
+CORPUS = os.environ.get("CORPUS", "outputs/corpus/standard")
 RUNS = "outputs/thesis_physics/harness/retrofit"
 HEALTHY = f"{CORPUS}/healthy_nominal_seed940"
 PLACEMENTS = [2, 5, 21, 22, 23]  # seeds of 4-sensor placements; the pool's are 10000 and up
@@ -80,7 +83,8 @@ pool_path = sys.argv[1]
 single_path = sys.argv[2] if len(sys.argv) > 2 else None
 pool = load_checkpoint(pool_path)
 print("# Placement self-calibration (retrofit harness, W = 32, seed 42, held-out session)\n")
-print(f"Made by `.venv/bin/python results/stock/self_calibration.py {' '.join(sys.argv[1:])}`.")
+print(f"Made by `CORPUS={CORPUS} .venv/bin/python results/stock/self_calibration.py "
+      f"{' '.join(sys.argv[1:])}`.")  # fmt: skip
 print(
     "Accuracy / localisation. *Told it*: the pool model given the true placement. "
     "*Self-calibrated*: commissioned on ten healthy minutes (seed 940) with the placement "

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.atomic import atomic_write_json
 from robohealth_mj.data import baseline
 from robohealth_mj.data.arrays import Recording, load_recordings
 from robohealth_mj.data.graphs import GraphSpec, harness_graph
@@ -34,6 +35,7 @@ from robohealth_mj.runtime.export import export_checkpoint, file_fingerprint
 from robohealth_mj.runtime.operating_point import Reading, match_operating_point
 from robohealth_mj.runtime.recouple import recouple
 
+PLACEMENT = "placement.json"  # the placement self-calibration found, [6, M]
 MINUTES = (0.5, 1.0, 2.0, 3.0, 5.0, 7.5, 10.0, 15.0, 20.0)
 SETTLED = 0.1  # a baseline has settled when it moves the residuals within 10 % of the final fit
 
@@ -99,6 +101,7 @@ def commission(
     tick_hz: float = 20.0,
     placement: dict | None = None,
     placement_fit: str = "motion",
+    operating_point: str = "per_class",
 ) -> dict[str, Any]:
     """Write ``out_dir/best.ckpt`` (and ``model.onnx`` for a network) commissioned on
     ``healthy``; the commissioning record (also in the checkpoint). A harness model with a
@@ -145,6 +148,9 @@ def commission(
         mean, std, record["placement"] = recouple(
             model, graph, arm, ref, mean, std, int(ckpt["window"]), placement_fit, drawn > 0
         )
+        # the placement found, as graph.coupling_file reads it: a model can be trained on it
+        record["placement"]["file"] = str(out_dir / PLACEMENT)
+        atomic_write_json(out_dir / PLACEMENT, record["placement"]["coupling"])
     elif placement:
         raise InputError(
             f"{ckpt_path}: placement= is for harness models with a coupling head; "
@@ -156,6 +162,7 @@ def commission(
         Reading(ref, trained, ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()),
         list((ckpt.get("split_runs") or {}).get("val", [])),
         Reading(arm, graph, mean, std),
+        operating_point,
     )
     save_checkpoint(
         out_dir / CHECKPOINT,
