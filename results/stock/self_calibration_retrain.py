@@ -3,15 +3,19 @@
 The motion fit (``runtime/recouple.py``) finds a retrofit kit's placement from ten healthy
 minutes of the arm (no labels). Here a model is trained from scratch on the training corpus
 re-mixed by that *estimated* placement (``graph.coupling_file``; the corpus keeps every joint's
-package, which is also what the motion fit reads), and scored on the held-out session mixed by
-the *true* placement, its sensors z-scored on the arm's healthy running. Against models trained
-on the true placement. Retrofit, W = 32, seed 42.
+package, which is also what the motion fit reads), and scored on data mixed by the *true*
+placement: first the validation runs of the training sessions, where the sensors' z-scores are
+chosen (the training's, or refitted on the arm's healthy running), then the held-out session.
+Against models trained on the true placement. Retrofit, W = 32, seed 42.
 
-    CORPUS=outputs/corpus/standard .venv/bin/python results/stock/self_calibration_retrain.py \\
+    CORPUS=... .venv/bin/python results/stock/self_calibration_retrain.py estimate POOL_CKPT
+    (then train outputs/selfcal/retrained/seed<S> on each estimate: results/stock/command.sh)
+    CORPUS=... .venv/bin/python results/stock/self_calibration_retrain.py \\
         > results/stock/self_calibration_retrain.md
 
-Inputs: ``outputs/selfcal/estimated/seed<S>.json`` and the runs in
-``outputs/selfcal/retrained/seed<S>`` (commands in ``results/stock/command.sh``).
+``estimate`` writes the motion fit's C for each placement to
+``outputs/selfcal/estimated/seed<S>.json`` (the pool checkpoint names the training data the fit
+reads); the second form scores the runs trained on them.
 """
 
 from __future__ import annotations

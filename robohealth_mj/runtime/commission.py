@@ -32,7 +32,7 @@ from robohealth_mj.learn.checkpoint import (
 )
 from robohealth_mj.learn.trainer import CHECKPOINT, expand_paths
 from robohealth_mj.runtime.export import export_checkpoint, file_fingerprint
-from robohealth_mj.runtime.operating_point import RECIPES, Reading, match_operating_point
+from robohealth_mj.runtime.operating_point import Reading, check_recipe, match_operating_point
 from robohealth_mj.runtime.recouple import recouple
 
 PLACEMENT = "placement.json"  # the placement self-calibration found, [6, M]
@@ -107,8 +107,7 @@ def commission(
     ``healthy``; the commissioning record (also in the checkpoint). A harness model with a
     coupling head also has its ``C`` refitted to the arm's ``placement``
     (:mod:`robohealth_mj.runtime.recouple`)."""
-    if operating_point not in RECIPES:  # before minutes of work, not after
-        raise InputError(f"operating_point must be one of {RECIPES}, got {operating_point!r}")
+    check_recipe(operating_point)  # before minutes of work, not after
     ckpt = load_checkpoint(ckpt_path)
     arm = _healthy(ckpt, healthy, "healthy")
     reference = reference or ckpt["config"].get("data", {}).get("train")

@@ -78,6 +78,24 @@ def per_class_offset(validation: np.ndarray, arm: np.ndarray) -> np.ndarray:
     return offset.astype(np.float32)
 
 
+def healthy_offset(validation: np.ndarray, arm: np.ndarray) -> np.ndarray:
+    """The offset ``[C]`` that raises only the healthy logit, by the one constant that has the
+    arm's healthy windows (``arm [K, C]`` logits) called healthy as often as the validation
+    session's (``validation``)."""
+    offset = np.zeros(arm.shape[1], np.float32)
+    rate = float((validation.argmax(1) == 0).mean())
+    margins = arm[:, 0] - arm[:, 1:].max(axis=1)
+    # only ever towards healthy: healthy running called healthy more often than in validation
+    # says nothing about faults missed, so it is no reason to call more
+    offset[0] = max(0.0, -float(np.quantile(margins, 1.0 - rate)))
+    return offset
+
+
+def check_recipe(recipe: str) -> None:
+    if recipe not in RECIPES:
+        raise InputError(f"operating_point must be one of {RECIPES}, got {recipe!r}")
+
+
 def healthy_logits(
     model: torch.nn.Module, reading: Reading, window: int, runs: list[str] | None = None
 ) -> np.ndarray:
@@ -107,6 +125,7 @@ def match_operating_point(
     ``healthy``; ``per_class``: called each fault class) at the rate the model calls its
     validation session's (``validation_runs`` of ``validation``, read as in training) healthy
     windows. Sets it on ``model``; returns it with a record."""
+    check_recipe(recipe)
     model.class_offset.zero_()
     target = healthy_logits(model, validation, window, validation_runs)
     logits = healthy_logits(model, arm, window)
@@ -117,15 +136,8 @@ def match_operating_point(
         record["skipped"] = "no healthy windows to match"
         return offset, record
     rate = float((target.argmax(1) == 0).mean())
-    if recipe not in RECIPES:
-        raise InputError(f"operating_point must be one of {RECIPES}, got {recipe!r}")
-    if recipe == "per_class":
-        offset = per_class_offset(target, logits)
-    else:
-        # only ever towards healthy: healthy running called healthy more often than in
-        # validation says nothing about faults missed, so it is no reason to call more
-        margins = logits[:, 0] - logits[:, 1:].max(axis=1)
-        offset[0] = max(0.0, -float(np.quantile(margins, 1.0 - rate)))
+    fit = per_class_offset if recipe == "per_class" else healthy_offset
+    offset = fit(target, logits)
     model.class_offset.copy_(torch.from_numpy(offset))
     record.update({
         "validation_healthy_rate": rate,
