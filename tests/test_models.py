@@ -270,3 +270,86 @@ def test_energy_scores_pin_the_coupling_s_sign_where_signed_scores_do_not():
         assert _localised(_head_with("energy", inverted, seed), sensor) != culprit
     with pytest.raises(ValueError, match="anomaly_scores must be one of"):
         _head_with("absolute", c0)
+
+
+def _pool_model(**options):
+    """An ``anomaly_residual`` on the harness graph (6 joints, 4 sensors) with the pool-model
+    options ``options`` (coupled_edges, anomaly_joint_scores, placement_embedding)."""
+    from robohealth_mj.data.graphs import harness_graph
+
+    graph = harness_graph(coupling_seed=3)
+    adjacency = graph.adjacency
+    model = _build("anomaly_residual", adjacency=adjacency, anomaly_scores="energy", **options)
+    model.anomaly.set_coupling(graph.coupling)
+    return model.eval(), graph.coupling
+
+
+def test_coupled_edges_are_the_placement_and_a_refitted_coupling_reaches_message_passing():
+    """Dense harness edges tell message passing nothing of the placement, so the class logits do
+    not depend on C; coupled edges are C itself, so a C refitted by commissioning changes what
+    every node hears, the rest of the model untouched."""
+    x = torch.randn(4, 8, 10, F)
+    other = harness_graph_coupling(7)
+    for coupled in (False, True):
+        model, c = _pool_model(coupled_edges=coupled)
+        edges = model.edges(x[:, -1, :, schema.feature_index("pos")])
+        with torch.no_grad():
+            before = model(x)["class_logits"]
+            model.anomaly.set_coupling(other)
+            after = model(x)["class_logits"]
+        if coupled:
+            np.testing.assert_allclose(edges[0, :6, 6:].detach(), np.maximum(c, 1e-2), rtol=1e-5)
+            np.testing.assert_allclose(edges[0, 6:, :6].detach(), np.maximum(c, 1e-2).T, rtol=1e-5)
+            assert (after - before).abs().max() > 1e-3
+        else:
+            assert (edges[0, :6, 6:] == 1.0).all()
+            torch.testing.assert_close(after, before)
+    with pytest.raises(Exception, match="need the coupling head"):  # hydra wraps the ValueError
+        _build("stgnn_fixed", coupled_edges=True)
+
+
+def harness_graph_coupling(seed: int) -> np.ndarray:
+    from robohealth_mj.data.graphs import harness_graph
+
+    return harness_graph(coupling_seed=seed).coupling
+
+
+def test_joint_scores_break_the_tie_of_joints_coupled_alike():
+    """Two joints with the same row of C get the same scattered score whatever the sensors
+    say; a per-joint score from each joint's own embedding tells them apart."""
+    c = harness_graph_coupling(3).copy()
+    c[1] = c[0]
+    nodes = torch.randn(5, 10, HIDDEN)
+    for joint_scores in (False, True):
+        model, _ = _pool_model(anomaly_joint_scores=joint_scores)
+        model.anomaly.set_coupling(c)
+        with torch.no_grad():
+            logits, _ = model.anomaly(nodes)
+        gap = (logits[:, 0] - logits[:, 1]).abs().max()
+        assert (gap > 1e-3) if joint_scores else (gap < 1e-5)
+
+
+def test_each_sensor_is_told_the_joints_it_hears():
+    """With the placement embedding a sensor's node embedding moves when its column of C does,
+    and nothing else moves."""
+    model, c = _pool_model(placement_embedding=True)
+    skip = torch.randn(3, 10, HIDDEN)
+    moved = c.copy()
+    moved[:, 2] = moved[::-1, 2]  # sensor 2 now hears other joints
+    with torch.no_grad():
+        a = model.placed(skip, torch.as_tensor(c).expand(3, -1, -1))
+        b = model.placed(skip, torch.as_tensor(moved).expand(3, -1, -1))
+    changed = (a - b).abs().amax(dim=(0, 2))
+    assert changed[8] > 1e-3
+    assert changed[[0, 1, 2, 3, 4, 5, 6, 7, 9]].max() == 0.0
+    torch.testing.assert_close(a[:, :6], skip[:, :6])
+
+
+def test_a_pool_model_with_every_option_exports_to_onnx_with_its_placement(tmp_path):
+    model, _ = _pool_model(coupled_edges=True, anomaly_joint_scores=True, placement_embedding=True)
+    with torch.no_grad():
+        model.backbone.encoder.node.normal_()
+    path = tmp_path / "pool.onnx"
+    export_onnx(model, torch.randn(2, 16, 10, F), path)
+    for batch in (1, 5):
+        assert onnx_parity(model, path, torch.randn(batch, 16, 10, F)) < 1e-4

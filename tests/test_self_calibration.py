@@ -27,10 +27,16 @@ from robohealth_mj.learn.placements import (
 from robohealth_mj.models.heads import AnomalyResidualHead
 from robohealth_mj.recorder import record_session
 from robohealth_mj.runtime.commission import commission
-from robohealth_mj.runtime.recouple import motion_estimate, reconstruction_estimate
+from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
+from robohealth_mj.runtime.recouple import (
+    motion_estimate,
+    reconstruction_estimate,
+    sparse_mixture,
+)
 from robohealth_mj.train import run
 
 J, S = schema.N_JOINTS, schema.SENSOR_CHANNELS
+OPTIONS = ("coupled_edges", "anomaly_joint_scores", "placement_embedding")
 POS, VEL = schema.feature_index("pos"), schema.feature_index("vel")
 
 
@@ -76,6 +82,32 @@ def test_each_window_is_mixed_by_the_placement_it_is_given():
     again, same = pool.mix(base, snapshots, torch.Generator().manual_seed(1))
     torch.testing.assert_close(again, mixed)
     torch.testing.assert_close(same, couplings)
+
+
+def test_with_placement_noise_the_model_is_given_the_placement_as_a_fit_would_find_it():
+    """``trainer.placement_noise=s``: the windows are still mixed by the drawn placement, but
+    the model is told it with the errors of a fit: scales off, a joint's weaker sensor missed
+    and a sensor it does not reach found (each about s / 2 of the time), its main sensor always
+    kept, nothing below the floor of a commissioned C."""
+    x = _snapshots()
+    graph = harness_graph()
+    exact = PlacementPool(graph, x, np.ones(len(x), bool), 8, torch.device("cpu"))
+    noisy = PlacementPool(graph, x, np.ones(len(x), bool), 8, torch.device("cpu"), noise=0.4)
+    snapshots = torch.arange(8 * 4000).remainder(len(x)).reshape(4000, 8)
+    base = torch.from_numpy(graph.transform(x))[snapshots]
+    mixed, truth = exact.mix(base, snapshots, torch.Generator().manual_seed(1))
+    noisy_mixed, told = noisy.mix(base, snapshots, torch.Generator().manual_seed(1))
+    torch.testing.assert_close(noisy_mixed, mixed)  # the data: the true placement
+    reached, main = truth > 0, truth == truth.amax(dim=2, keepdim=True)
+    weaker = reached & ~main
+    assert (told[main] > 0.011).all()
+    assert 0.15 < (told[weaker] <= 0.01).float().mean() < 0.25  # missed
+    assert 0.15 < (told[~reached] > 0.01).float().mean() < 0.25  # found where it is not
+    assert told.min() >= 0.01 - 1e-7
+    ratio = torch.log(told[main] / truth[main])
+    assert 0.35 < float(ratio.std()) < 0.45  # scales off by exp(0.4 N(0, 1))
+    with pytest.raises(ValueError, match="placement_noise"):
+        PlacementPool(graph, x, np.ones(len(x), bool), 8, torch.device("cpu"), noise=-0.1)
 
 
 def test_a_given_coupling_takes_the_place_of_the_learned_one():
@@ -134,14 +166,33 @@ def test_the_motion_fit_finds_the_placement_from_healthy_running():
     assert np.mean(corr) > 0.985  # 0.991 (without the z-scoring's offset per channel: 0.971)
 
 
+def test_the_fit_drops_joints_that_barely_explain_a_sensor_and_keeps_the_ones_that_do():
+    """A sensor mounted to hear joints 1 and 4 (weights 1 and 0.5), with a faint hum of every
+    other drive through the structure (0.02) and noise: a plain non-negative fit gives every
+    joint weight; pruning leaves exactly joints 1 and 4, at their weights."""
+    rng = np.random.default_rng(0)
+    packages = rng.normal(size=(2000, J))
+    hum = 0.02 * packages[:, [0, 2, 3, 5]].sum(axis=1)
+    sensor = packages[:, 1] + 0.5 * packages[:, 4] + hum + 0.3 * rng.normal(size=2000) + 2.0
+    offsets = np.ones((2000, 1))
+    plain = sparse_mixture(packages, offsets, sensor, prune=0.0)
+    assert np.count_nonzero(plain) == J
+    pruned = sparse_mixture(packages, offsets, sensor, prune=0.006)
+    assert np.flatnonzero(pruned).tolist() == [1, 4]
+    np.testing.assert_allclose(pruned[[1, 4]], [1.0, 0.5], atol=0.03)
+
+
 @pytest.fixture(scope="module")
 def drawn(tiny_corpus, tmp_path_factory) -> dict:
-    """A barely trained ``anomaly_residual`` under four drawn placements (harness, W = 8)."""
+    """A barely trained self-calibrating model (``+experiment=self_calibrating``: the placement
+    told to edges, sensors and head, given as a fit finds it) under four drawn placements
+    (harness, W = 8)."""
     root = tmp_path_factory.mktemp("drawn")
     cfg = compose_config("train", [
         f"data.train=[{tiny_corpus}/train_*]", f"data.evaluate.heldout={tiny_corpus}/heldout",
-        "data.evaluate.probe=null", "trainer.progress=false", "window=8", "graph=harness",
-        "variant=anomaly_residual", "model.hidden=8", "trainer.epochs=1", "trainer.placements=4",
+        "data.evaluate.probe=null", "trainer.progress=false", "+experiment=self_calibrating",
+        "window=8", "model.hidden=8", "trainer.epochs=1", "trainer.placements=4",
+        "trainer.placement_noise=0.3",
     ])  # fmt: skip
     return {"results": run(cfg, root), "ckpt": root / "best.ckpt", "corpus": tiny_corpus}
 
@@ -149,6 +200,7 @@ def drawn(tiny_corpus, tmp_path_factory) -> dict:
 def test_a_model_trained_under_drawn_placements_is_given_its_own(drawn):
     assert drawn["results"]["train"]["placements_drawn"] == 4
     ckpt = load_checkpoint(drawn["ckpt"])
+    assert {k: ckpt["model_cfg"][k] for k in OPTIONS} == dict.fromkeys(OPTIONS, True)
     c = build(ckpt).anomaly.coupling().detach().numpy()
     np.testing.assert_allclose(c, np.maximum(DEFAULT_C0, 1e-2), rtol=1e-4)
 
@@ -215,3 +267,27 @@ def test_the_reconstruction_fit_lowers_the_models_reconstruction_error(
     assert found["reconstruction_after"] < found["reconstruction_before"]
     refitted = build(load_checkpoint(tmp_path / "best.ckpt")).anomaly.coupling().detach().numpy()
     np.testing.assert_allclose(refitted, found["coupling"], atol=1e-4)
+
+
+def test_a_commissioned_self_calibrating_model_streams_as_it_scores_windows(
+    drawn, healthy_arm, tmp_path
+):
+    """The placement found reaches the exported model's edges, sensors and head alike: the
+    fleet runtime's incremental form (one snapshot a tick) gives the windowed form's
+    probabilities on the arm's running."""
+    record = commission(drawn["ckpt"], str(healthy_arm), tmp_path, placement={"coupling_seed": 3})
+    x = load_recordings([healthy_arm / "graphs.jsonl"]).x
+    probs, modes = [], []
+    for incremental in (True, False):
+        fleet = FleetRuntime(record["onnx"], incremental=incremental)
+        modes.append(fleet.mode)
+        slots = fleet.register(["a", "b"])
+        decided = []
+        for t in range(40):
+            r = fleet.step(slots, np.full(2, t), np.full(2, 0.05 * (t + 1)), x[[t, t + 100]])
+            decided.append(np.where((r.status == DECIDED)[:, None], r.probs, np.nan))
+        probs.append(np.array(decided))
+    assert modes == ["incremental", "windowed"]
+    assert (~np.isnan(probs[0])).sum() > 100
+    np.testing.assert_array_equal(np.isnan(probs[0]), np.isnan(probs[1]))
+    assert np.nanmax(np.abs(probs[0] - probs[1])) <= 1e-4

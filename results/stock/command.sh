@@ -18,24 +18,63 @@ $PY -m robohealth_mj.record seed=950 faults=none session.duration_s=600 \
 $PY results/stock/operating_point_recipe.py "$CORPUS"               # -> operating_point_recipe.md
 $PY results/stock/unseen_program.py "$CORPUS"                       # -> unseen_program.md
 $PY results/stock/program_strata.py "$CORPUS" > results/stock/program_strata.md
-# Placement self-calibration (retrofit harness, W = 32, seed 42): a model trained under 256 drawn
+# Placement self-calibration (retrofit harness, W = 32, seed 42): models trained under 256 drawn
 # placements, models trained on each test placement (the references), then commissioning on ten
 # healthy minutes of the nominal arm.
 $PY -m robohealth_mj.record seed=940 faults=none session.duration_s=600 session.progress=false \
   session.out_dir="$CORPUS/healthy_nominal_seed940"
 H="graph=harness sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy window=32"
 D="data.train=[$CORPUS/train_*] data.evaluate.heldout=$CORPUS/heldout_seed900"
+P="$H $D data.evaluate.probe=null trainer.placements=256 trainer.epochs=40 trainer.patience=8"
+P="$P trainer.threads=1"
+S=outputs/selfcal
+# The pool model's design (pool_design.md): the earlier dense-edge model, then the placement told
+# to message passing, the head's joint scores and the sensor nodes, alone and together; the
+# chosen one (+experiment=self_calibrating, the same settings); the same told C with a fit's errors.
 # shellcheck disable=SC2086
-$PY -m robohealth_mj.train $H $D data.evaluate.probe=null trainer.placements=256 \
-  trainer.epochs=40 trainer.patience=8 trainer.threads=1 out_dir=outputs/selfcal/pool256_e40
+{
+  $PY -m robohealth_mj.train $P out_dir=$S/pool256_e40
+  $PY -m robohealth_mj.train $P model.coupled_edges=true out_dir=$S/pool256_e40_edges
+  $PY -m robohealth_mj.train $P model.anomaly_joint_scores=true out_dir=$S/pool256_e40_joint
+  $PY -m robohealth_mj.train $P model.coupled_edges=true model.anomaly_joint_scores=true \
+    out_dir=$S/pool256_e40_edges_joint
+  $PY -m robohealth_mj.train $P model.anomaly_joint_scores=true model.placement_embedding=true \
+    out_dir=$S/pool256_e40_joint_placed
+  $PY -m robohealth_mj.train +experiment=self_calibrating sensing=retrofit $D \
+    data.evaluate.probe=null trainer.threads=1 out_dir=$S/pool256_e40_edges_joint_placed
+  $PY -m robohealth_mj.train +experiment=self_calibrating sensing=retrofit $D \
+    data.evaluate.probe=null trainer.threads=1 trainer.placement_noise=0.3 \
+    out_dir=$S/pool256_e40_edges_joint_placed_noise03
+}
+CORPUS=$CORPUS THREADS=2 $PY results/stock/pool_design.py dense=$S/pool256_e40/best.ckpt \
+  edges=$S/pool256_e40_edges/best.ckpt joint_scores=$S/pool256_e40_joint/best.ckpt \
+  edges+joint_scores=$S/pool256_e40_edges_joint/best.ckpt \
+  joint_scores+placement_embedding=$S/pool256_e40_joint_placed/best.ckpt \
+  edges+joint_scores+placement_embedding=$S/pool256_e40_edges_joint_placed/best.ckpt \
+  edges+joint_scores+placement_embedding+noise_0.3=$S/pool256_e40_edges_joint_placed_noise03/best.ckpt \
+  > results/stock/pool_design.md
 # shellcheck disable=SC2086
 $PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs=2 trainer.threads=1 \
   hydra.sweep.dir=outputs/thesis_physics $D data.evaluate.probe=$CORPUS/probe_payload_high_seed901 \
   +experiment=placements sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy \
   graph.coupling_sensors=4 graph.coupling_seed=2,5,21,22,23
-CORPUS=$CORPUS $PY results/stock/self_calibration.py outputs/selfcal/pool256_e40/best.ckpt \
+CORPUS=$CORPUS $PY results/stock/self_calibration.py $S/pool256_e40_edges_joint_placed/best.ckpt \
   outputs/thesis_physics/harness/retrofit/C0/anomaly_residual/w32/seed42/best.ckpt \
   > results/stock/self_calibration.md
+CORPUS=$CORPUS $PY results/stock/self_calibration.py $S/pool256_e40/best.ckpt \
+  > results/stock/self_calibration_dense_pool.md
+# A second seed of the chosen pool model and of the trained-on-placement references.
+# shellcheck disable=SC2086
+$PY -m robohealth_mj.train +experiment=self_calibrating sensing=retrofit $D seed=43 \
+  data.evaluate.probe=null trainer.threads=1 out_dir=$S/self_calibrating_seed43
+# shellcheck disable=SC2086
+$PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs=2 trainer.threads=1 \
+  hydra.sweep.dir=outputs/thesis_physics $D data.evaluate.probe=$CORPUS/probe_payload_high_seed901 \
+  +experiment=placements sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy \
+  graph.coupling_sensors=4 graph.coupling_seed=2,5,21,22,23 seed=43
+CORPUS=$CORPUS $PY results/stock/self_calibration.py $S/self_calibrating_seed43/best.ckpt \
+  outputs/thesis_physics/harness/retrofit/C0/anomaly_residual/w32/seed43/best.ckpt \
+  > results/stock/self_calibration_seed43.md
 # Ablation: a model trained from scratch on the placement the motion fit found (the rest as the
 # trained-on-placement references), scored on the held-out session mixed by the true placement.
 CORPUS=$CORPUS $PY results/stock/self_calibration_retrain.py estimate outputs/selfcal/pool256_e40/best.ckpt

@@ -7,7 +7,8 @@ trained on that placement. Retrofit sensing, W = 32, held-out session.
 
 POOL_CKPT: trained with ``trainer.placements=256`` (command in results/stock/command.sh);
 SINGLE_CKPT: the campaign's model trained on C0 alone (for contrast). Trained-on-placement
-references: the campaign's runs under ``outputs/thesis_physics/harness/retrofit/<placement>``.
+references: the campaign's runs of the pool model's seed under
+``outputs/thesis_physics/harness/retrofit/<placement>``.
 CORPUS (default ``outputs/corpus/standard``) holds the held-out session and ten healthy minutes
 of the nominal arm (``healthy_nominal_seed940``, recorded by ``results/stock/command.sh``).
 """
@@ -82,7 +83,8 @@ def fmt(s: tuple[float, float]) -> str:
 pool_path = sys.argv[1]
 single_path = sys.argv[2] if len(sys.argv) > 2 else None
 pool = load_checkpoint(pool_path)
-print("# Placement self-calibration (retrofit harness, W = 32, seed 42, held-out session)\n")
+SEED = int(pool["config"]["seed"])  # the references: the campaign's runs of the pool's seed
+print(f"# Placement self-calibration (retrofit harness, W = 32, seed {SEED}, held-out session)\n")
 print(f"Made by `CORPUS={CORPUS} .venv/bin/python results/stock/self_calibration.py "
       f"{' '.join(sys.argv[1:])}`.")  # fmt: skip
 print(
@@ -96,12 +98,13 @@ print("| placement | trained on it (acc. / loc.) | pool model, told it | pool mo
       "C0-only model, motion fit |")  # fmt: skip
 print("|---|---|---|---|---|---|---|---|")
 c0 = graph_from_checkpoint(pool).coupling
-print(f"| C0 | {fmt(score(load_checkpoint(f'{RUNS}/C0/anomaly_residual/w32/seed42/best.ckpt')))} "
+c0_ref = load_checkpoint(f"{RUNS}/C0/anomaly_residual/w32/seed{SEED}/best.ckpt")
+print(f"| C0 | {fmt(score(c0_ref))} "
       f"| {fmt(given(pool, c0))} | — | — | — | — | — |")  # fmt: skip
 rows = []
 for seed in PLACEMENTS:
     c = harness_graph(coupling_seed=seed, coupling_sensors=4).coupling
-    ref_path = Path(f"{RUNS}/seed{seed}_m4/anomaly_residual/w32/seed42/best.ckpt")
+    ref_path = Path(f"{RUNS}/seed{seed}_m4/anomaly_residual/w32/seed{SEED}/best.ckpt")
     ref = score(load_checkpoint(ref_path)) if ref_path.is_file() else None
     motion, corr_m = commissioned(pool_path, seed)
     recon, corr_r = commissioned(pool_path, seed, "reconstruction")

@@ -13,9 +13,9 @@ Against models trained on the true placement. Retrofit, W = 32, seed 42.
     CORPUS=... .venv/bin/python results/stock/self_calibration_retrain.py \\
         > results/stock/self_calibration_retrain.md
 
-``estimate`` writes the motion fit's C for each placement to
-``outputs/selfcal/estimated/seed<S>.json`` (the pool checkpoint names the training data the fit
-reads); the second form scores the runs trained on them.
+``estimate`` writes the motion fit's C (unpruned, as when this ablation was run) for each
+placement to ``outputs/selfcal/estimated/seed<S>.json`` (the pool checkpoint names the training
+data the fit reads); the second form scores the runs trained on them.
 """
 
 from __future__ import annotations
@@ -83,7 +83,7 @@ def estimate(pool_path: str) -> None:
     (SELFCAL / "estimated").mkdir(parents=True, exist_ok=True)
     for seed in PLACEMENTS:
         truth = harness_graph(coupling_seed=seed, coupling_sensors=4).coupling
-        c = motion_estimate(reference, healthy, replace(graph, coupling=truth))
+        c = motion_estimate(reference, healthy, replace(graph, coupling=truth), prune=0.0)
         (SELFCAL / "estimated" / f"seed{seed}.json").write_text(json.dumps(c.tolist()))
 
 

@@ -18,6 +18,7 @@ import torch
 from robohealth_mj import schema
 from robohealth_mj.data.graphs import GraphSpec, random_coupling
 from robohealth_mj.errors import InputError
+from robohealth_mj.models.heads import COUPLING_FLOOR
 
 POOL_SEED = 10_000  # pool placements come from seeds POOL_SEED + k: apart from campaign seeds
 
@@ -58,11 +59,15 @@ class PlacementPool:
         healthy: np.ndarray,
         size: int,
         device: torch.device,
+        noise: float = 0.0,
     ) -> None:
         if graph.coupling is None:
             raise InputError("trainer.placements needs graph=harness (a placement to draw)")
         if size < 2:
             raise InputError(f"trainer.placements: a pool of at least 2 placements, got {size}")
+        if not 0.0 <= noise < 2.0:
+            raise InputError(f"trainer.placement_noise must be in [0, 2), got {noise}")
+        self.noise = float(noise)
         j, m = graph.coupling.shape
         couplings = np.stack([random_coupling(POOL_SEED + k, m, j) for k in range(size)])
         packages = x[:, schema.N_JOINTS :, schema.SENSOR_CHANNELS].astype(np.float64)
@@ -93,4 +98,21 @@ class PlacementPool:
         mixed = (mixed - self.mean[k][:, None]) / self.std[k][:, None]
         out = x.clone()
         out[:, :, self.num_joints :, schema.SENSOR_CHANNELS] = mixed
-        return out, c
+        return out, self.as_found(c, generator) if self.noise else c
+
+    def as_found(self, c: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        """Placements ``c [B, J, M]`` as a fit from healthy running finds them: every entry's
+        scale off by ``exp(s N(0, 1))``, a joint's weaker sensor missed and a sensor it does
+        not reach found, each with probability ``s / 2``; raised to the floor a commissioned
+        ``C`` has (softplus never reaches zero), which also keeps a sensor whose only joint was
+        missed in the normalisations. The data stay mixed by ``c``."""
+        s = self.noise
+        scale, coin, value = (
+            draw(c.shape, generator=generator).to(c.device)
+            for draw in (torch.randn, torch.rand, torch.rand)
+        )
+        reached = c > 0
+        weaker = reached & (c < c.amax(dim=2, keepdim=True))
+        found = torch.where(reached, c * torch.exp(s * scale), s * value)
+        keep = torch.where(reached, ~(weaker & (coin < s / 2)), coin < s / 2)
+        return (found * keep).clamp_min(COUPLING_FLOOR)

@@ -152,17 +152,27 @@ def prepare(cfg: DictConfig) -> Prepared:
     ).to(device)
     pool = None
     if cfg.trainer.get("placements"):
-        pool = placement_pool(graph, rec, splits["train"], int(cfg.trainer.placements), device)
+        pool = placement_pool(
+            graph,
+            rec,
+            splits["train"],
+            int(cfg.trainer.placements),
+            device,
+            float(cfg.trainer.get("placement_noise") or 0.0),
+        )
         given_placement(model, graph, pool, mean, std)
     tensors = WindowTensors(x, rec, mean, std, device)
     return Prepared(cfg, graph, rec, splits, mean, std, tensors, model, device, pool)
 
 
-def placement_pool(graph: GraphSpec, rec, train: Any, size: int, device) -> PlacementPool:
+def placement_pool(
+    graph: GraphSpec, rec, train: Any, size: int, device, noise: float = 0.0
+) -> PlacementPool:
     """The pool of drawn placements and the packages they mix (the profile's channels), with
     the healthy training snapshots that z-score them."""
     x = rec.x if graph.channel_mask is None else rec.x * graph.channel_mask
-    return PlacementPool(graph, x, covered(train, len(rec)) & ~rec.active, size, device)
+    healthy = covered(train, len(rec)) & ~rec.active
+    return PlacementPool(graph, x, healthy, size, device, noise)
 
 
 def given_placement(model, graph: GraphSpec, pool: PlacementPool, mean, std) -> None:

@@ -8,6 +8,10 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from robohealth_mj.errors import InputError
+
+COUPLING_FLOOR = 1e-2  # a set C's smallest entry: softplus never reaches zero
+
 
 def mlp(in_dim: int, hidden: int, out_dim: int, dropout: float = 0.0) -> nn.Sequential:
     return nn.Sequential(
@@ -72,6 +76,11 @@ class AnomalyResidualHead(nn.Module):
     winning. ``scores="energy"`` scores ``||W r_m||^2 / H``: zero for a sensor predicted exactly,
     growing with its residual, so the joint that wins is the one coupled most to the sensors
     that deviate, which pins C's sign.
+
+    ``joint_scores`` adds a per-joint score ``v(h_j)`` from each joint's own embedding. Told a
+    placement (a pool model), the scattered scores alone are a fixed function of the sensors'
+    scores, so two joints coupled to the same sensors alike always tie; ``v`` can break the tie
+    with the joint's own motion and what message passing brought it.
     """
 
     SCORES = ("signed", "energy")
@@ -83,16 +92,18 @@ class AnomalyResidualHead(nn.Module):
         num_sensors: int,
         init_noise: float = 0.01,
         scores: str = "signed",
+        joint_scores: bool = False,
     ) -> None:
         super().__init__()
         if scores not in self.SCORES:
-            raise ValueError(f"model.anomaly_scores must be one of {self.SCORES}, got {scores!r}")
+            raise InputError(f"model.anomaly_scores must be one of {self.SCORES}, got {scores!r}")
         self.num_joints, self.num_sensors = num_joints, num_sensors
         self.init_noise = float(init_noise)
         self.coupling_logits = nn.Parameter(torch.empty(num_joints, num_sensors))
         self.f = mlp(hidden, hidden, hidden)
         self.scores = scores
         self.g = mlp(hidden, hidden, 1) if scores == "signed" else nn.Linear(hidden, hidden, False)
+        self.v = mlp(hidden, hidden, 1) if joint_scores else None
         self.reset_parameters()
 
     def reset_parameters(self) -> None:
@@ -102,7 +113,7 @@ class AnomalyResidualHead(nn.Module):
         return F.softplus(self.coupling_logits)
 
     @torch.no_grad()
-    def set_coupling(self, c: torch.Tensor | np.ndarray, floor: float = 1e-2) -> None:
+    def set_coupling(self, c: torch.Tensor | np.ndarray, floor: float = COUPLING_FLOOR) -> None:
         """Set ``C`` to a given placement ``[J, M]`` (entries below ``floor`` are raised to it,
         since softplus never reaches zero): a placement known, or a start for refitting."""
         c = torch.as_tensor(np.asarray(c), dtype=torch.float32).clamp_min(floor)
@@ -133,6 +144,8 @@ class AnomalyResidualHead(nn.Module):
         else:
             scores = self.g(residual).square().mean(-1)  # [B, M], >= 0, grows with |r_m|
         logits = torch.einsum(f"bm,{per_window}jm->bj", scores, c_scat)  # [B, J]
+        if self.v is not None:
+            logits = logits + self.v(h).squeeze(-1)
         energy = torch.einsum(f"bm,{per_window}jm->bj", residual.square().mean(-1), c_scat)
         return logits, energy
 

@@ -78,9 +78,9 @@ class PooledHead(nn.Module):
         return list(OUTPUTS[: 3 if self.has_severity else 2])
 
     def forward(self, views: torch.Tensor, z_last: torch.Tensor) -> tuple[torch.Tensor, ...]:
-        skip = self.encoder.embed([views])
+        skip = self.model.placed(self.encoder.embed([views]))
         positions = z_last[..., self.model.pos_index]
-        adj = self.model.adjacency(positions)
+        adj = self.model.edges(positions)
         refined, temporal, skip = self.model.backbone.message_passing(skip, adj)
         out = self.model.heads(positions, refined, temporal, skip)
         return tuple(out[name] for name in self.output_names)

@@ -14,6 +14,7 @@ import torch
 from torch import nn
 
 from robohealth_mj import schema
+from robohealth_mj.errors import InputError
 from robohealth_mj.models.adjacency import AdjacencyBuilder
 from robohealth_mj.models.backbone import GraphConvFactory, WindowBackbone
 from robohealth_mj.models.heads import (
@@ -47,6 +48,9 @@ class STGNN(nn.Module):
         spectral_features: bool = False,
         anomaly_head: bool = False,
         anomaly_scores: str = "signed",
+        coupled_edges: bool = False,
+        anomaly_joint_scores: bool = False,
+        placement_embedding: bool = False,
         severity_head: bool = False,
         pos_index: int = schema.feature_index("pos"),
     ) -> None:
@@ -76,10 +80,26 @@ class STGNN(nn.Module):
             max_pool=max_pool,
         )
         self.anomaly = (
-            AnomalyResidualHead(hidden, num_joints, n - num_joints, scores=anomaly_scores)
+            AnomalyResidualHead(
+                hidden,
+                num_joints,
+                n - num_joints,
+                scores=anomaly_scores,
+                joint_scores=anomaly_joint_scores,
+            )
             if anomaly_head
             else None
         )
+        if (coupled_edges or anomaly_joint_scores or placement_embedding) and not anomaly_head:
+            raise InputError(
+                "model.coupled_edges, anomaly_joint_scores and placement_embedding need the "
+                "coupling head (anomaly_head: true)"
+            )
+        if placement_embedding and not hasattr(self.backbone, "message_passing"):
+            raise InputError("model.placement_embedding needs backbone=window")
+        self.coupled_edges = coupled_edges
+        # each sensor's embedding is told which joints it hears: its column of C
+        self.placement = nn.Linear(num_joints, hidden, bias=False) if placement_embedding else None
         self.localise = None if anomaly_head else NodeLocalisationHead(hidden, num_joints, dropout)
         self.severity = SeverityHead(hidden, dropout) if severity_head else None
         # added to the class logits; set by commissioning (runtime/operating_point.py)
@@ -89,21 +109,51 @@ class STGNN(nn.Module):
         """Refined per-node embeddings ``[B, N, H]`` (what the heads read)."""
         return self._features(x)[1][0]
 
-    def _features(self, x: torch.Tensor):
-        positions = x[:, -1, :, self.pos_index]  # [B, N], standardised
+    def edges(self, positions: torch.Tensor, coupling: torch.Tensor | None = None) -> torch.Tensor:
+        """Edge weights ``[B, N, N]`` the convolutions see. With ``coupled_edges`` the
+        joint-sensor block is the placement (``coupling [B, J, M]`` when given, else the head's
+        ``C``) instead of dense: message passing is told which sensors hear which joint, and a
+        placement refitted by commissioning reaches it with the rest of the model frozen."""
         adj = self.adjacency(positions)
+        if not self.coupled_edges:
+            return adj
+        j = self.num_joints
+        block = adj[:, :j, j:]
+        c = self.anomaly.coupling() + torch.zeros_like(block) if coupling is None else coupling
+        top = torch.cat([adj[:, :j, :j], c], dim=-1)
+        bottom = torch.cat([c.transpose(1, 2), adj[:, j:, j:]], dim=-1)
+        return torch.cat([top, bottom], dim=1)
+
+    def placed(self, skip: torch.Tensor, coupling: torch.Tensor | None = None) -> torch.Tensor:
+        """Encoder output ``skip [B, N, H]`` with each sensor told its placement: with
+        ``placement_embedding``, a learned projection of its column of ``C`` (``coupling
+        [B, J, M]`` when given, else the head's), normalised over joints, added to its
+        embedding. A pool model's sensor nodes have no fixed meaning; this gives them one."""
+        if self.placement is None:
+            return skip
+        j = self.num_joints
+        c = self.anomaly.coupling() if coupling is None else coupling  # [J, M] or [B, J, M]
+        heard = (c / c.sum(dim=-2, keepdim=True)).transpose(-1, -2)  # [(B,) M, J]
+        return torch.cat([skip[:, :j], skip[:, j:] + self.placement(heard)], dim=1)
+
+    def _features(self, x: torch.Tensor, coupling: torch.Tensor | None = None):
+        positions = x[:, -1, :, self.pos_index]  # [B, N], standardised
+        adj = self.edges(positions, coupling)
         features = x
         if self.spectral is not None:
             spec = self.spectral(x).unsqueeze(1).expand(-1, x.shape[1], -1, -1)
             features = torch.cat([x, spec], dim=-1)
-        return positions, self.backbone(features, adj)
+        if self.placement is None:
+            return positions, self.backbone(features, adj)
+        skip = self.placed(self.backbone.encoder(features), coupling)
+        return positions, self.backbone.message_passing(skip, adj)
 
     def forward(
         self, x: torch.Tensor, coupling: torch.Tensor | None = None
     ) -> dict[str, torch.Tensor]:
         """``coupling [B, J, M]``: each window's placement in place of the learned ``C``
         (training under drawn placements); coupling-head models only."""
-        positions, (refined, temporal, skip) = self._features(x)
+        positions, (refined, temporal, skip) = self._features(x, coupling)
         return self.heads(positions, refined, temporal, skip, coupling)
 
     def heads(
@@ -131,4 +181,4 @@ class STGNN(nn.Module):
 
     def learned_adjacency(self, positions: torch.Tensor) -> torch.Tensor:
         """The edge weights the convolutions see for given standardised positions ``[B, N]``."""
-        return self.adjacency(positions)
+        return self.edges(positions)
