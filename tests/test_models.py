@@ -12,6 +12,7 @@ from omegaconf import OmegaConf
 
 from robohealth_mj import schema
 from robohealth_mj.config import compose_config
+from robohealth_mj.data.graphs import harness_graph
 from robohealth_mj.models import NETWORK_VARIANTS, build_model
 from robohealth_mj.models import VARIANTS as ALL_VARIANTS
 from robohealth_mj.models.backbone import ThesisBackbone, WindowBackbone
@@ -275,8 +276,6 @@ def test_energy_scores_pin_the_coupling_s_sign_where_signed_scores_do_not():
 def _pool_model(**options):
     """An ``anomaly_residual`` on the harness graph (6 joints, 4 sensors) with the pool-model
     options ``options`` (coupled_edges, anomaly_joint_scores, placement_embedding)."""
-    from robohealth_mj.data.graphs import harness_graph
-
     graph = harness_graph(coupling_seed=3)
     adjacency = graph.adjacency
     model = _build("anomaly_residual", adjacency=adjacency, anomaly_scores="energy", **options)
@@ -289,7 +288,7 @@ def test_coupled_edges_are_the_placement_and_a_refitted_coupling_reaches_message
     not depend on C; coupled edges are C itself, so a C refitted by commissioning changes what
     every node hears, the rest of the model untouched."""
     x = torch.randn(4, 8, 10, F)
-    other = harness_graph_coupling(7)
+    other = harness_graph(coupling_seed=7).coupling
     for coupled in (False, True):
         model, c = _pool_model(coupled_edges=coupled)
         edges = model.edges(x[:, -1, :, schema.feature_index("pos")])
@@ -304,20 +303,14 @@ def test_coupled_edges_are_the_placement_and_a_refitted_coupling_reaches_message
         else:
             assert (edges[0, :6, 6:] == 1.0).all()
             torch.testing.assert_close(after, before)
-    with pytest.raises(Exception, match="need the coupling head"):  # hydra wraps the ValueError
+    with pytest.raises(Exception, match="need the coupling head"):  # Hydra wraps the InputError
         _build("stgnn_fixed", coupled_edges=True)
-
-
-def harness_graph_coupling(seed: int) -> np.ndarray:
-    from robohealth_mj.data.graphs import harness_graph
-
-    return harness_graph(coupling_seed=seed).coupling
 
 
 def test_joint_scores_break_the_tie_of_joints_coupled_alike():
     """Two joints with the same row of C get the same scattered score whatever the sensors
     say; a per-joint score from each joint's own embedding tells them apart."""
-    c = harness_graph_coupling(3).copy()
+    c = harness_graph(coupling_seed=3).coupling.copy()
     c[1] = c[0]
     nodes = torch.randn(5, 10, HIDDEN)
     for joint_scores in (False, True):

@@ -248,6 +248,8 @@ def test_a_placement_the_model_cannot_read_is_one_line(drawn, stock_deployed, he
                             "placement.coupling_sensors=6"],
         "no placement to calibrate": [f"model={stock_deployed['ckpt']}",
                                       "placement.coupling_seed=3"],
+        "placement_prune must be in [0, 1)": [f"model={drawn['ckpt']}",
+                                              "placement.coupling_seed=3", "placement_prune=-1"],
     }  # fmt: skip
     for message, args in bad.items():
         with pytest.raises(SystemExit) as stop:

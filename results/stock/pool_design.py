@@ -18,7 +18,6 @@ import os
 import sys
 import tempfile
 from dataclasses import replace
-from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -65,17 +64,14 @@ def score(ckpt: dict, c: np.ndarray, data: Recording, val_only: bool) -> np.ndar
     return np.array([m["accuracy"], m["localisation_accuracy"]])
 
 
-PRUNED = recouple.motion_estimate
-
-
 def self_calibrated(
     path: str, seed: int, data: Recording, prune: float
 ) -> tuple[np.ndarray, float]:
     """Commission ``path`` on the arm mixed by placement ``seed`` (hidden), the motion fit
     pruned at ``prune``, then score it."""
-    recouple.motion_estimate = partial(PRUNED, prune=prune)
     with tempfile.TemporaryDirectory() as out:
-        record = commission(path, HEALTHY, out, export=False, placement={"coupling_seed": seed})
+        record = commission(path, HEALTHY, out, export=False, placement={"coupling_seed": seed},
+                            placement_prune=prune)  # fmt: skip
         ckpt = load_checkpoint(Path(out) / "best.ckpt")
     truth = harness_graph(coupling_seed=seed, coupling_sensors=4).coupling
     graph = replace(graph_from_checkpoint(ckpt), coupling=truth)  # the arm mixes by the truth

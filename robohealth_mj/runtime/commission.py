@@ -101,6 +101,7 @@ def commission(
     tick_hz: float = 20.0,
     placement: dict | None = None,
     placement_fit: str = "motion",
+    placement_prune: float | None = None,
     operating_point: str = "per_class",
 ) -> dict[str, Any]:
     """Write ``out_dir/best.ckpt`` (and ``model.onnx`` for a network) commissioned on
@@ -147,7 +148,16 @@ def commission(
         graph = replace(graph, coupling=arm_placement(graph, placement))
         drawn = int((ckpt["config"].get("trainer") or {}).get("placements") or 0)
         mean, std, record["placement"] = recouple(
-            model, graph, arm, ref, mean, std, int(ckpt["window"]), placement_fit, drawn > 0
+            model,
+            graph,
+            arm,
+            ref,
+            mean,
+            std,
+            int(ckpt["window"]),
+            placement_fit,
+            drawn > 0,
+            prune=placement_prune,
         )
         # the placement found, as graph.coupling_file reads it: a model can be trained on it
         record["placement"]["file"] = str(out_dir / PLACEMENT)

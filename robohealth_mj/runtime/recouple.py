@@ -153,15 +153,20 @@ def recouple(
     fit: str = "motion",
     refit_sensor_statistics: bool = True,
     seed: int = 0,
+    prune: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
     """Refit ``model``'s ``C`` in place on ``arm`` (healthy, read through ``world``: the
     profile, commissioning shift and the placement the sensors really sit in). With
     ``refit_sensor_statistics`` the sensors are z-scored on this arm's healthy running, as the
     model was trained (``trainer.placements``). Returns the normalisation and a record: the
     refitted ``C``, the reconstruction fit's error before and after and, where the placement is
-    known (simulation), ``C``'s correlation with it."""
+    known (simulation), ``C``'s correlation with it. ``prune``: the motion fit's (None:
+    :data:`PRUNE`)."""
     if fit not in FITS:
         raise InputError(f"placement_fit must be one of {FITS}, got {fit!r}")
+    prune = PRUNE if prune is None else float(prune)
+    if not 0.0 <= prune < 1.0:
+        raise InputError(f"placement_prune must be in [0, 1), got {prune}")
     mean, std = mean.copy(), std.copy()
     j = world.num_joints
     if refit_sensor_statistics:
@@ -182,7 +187,8 @@ def recouple(
         before, after = reconstruction_estimate(head, nodes, seed)
         record.update(reconstruction_before=before, reconstruction_after=after)
     else:
-        head.set_coupling(motion_estimate(reference, arm, world))
+        head.set_coupling(motion_estimate(reference, arm, world, prune))
+        record["prune"] = prune
     coupling = head.coupling().detach().numpy()
     record["coupling"] = coupling.round(5).tolist()
     record["sensor_statistics"] = "refitted" if refit_sensor_statistics else "kept"
