@@ -45,6 +45,13 @@ healthy = load_recordings([f"{HEALTHY}/graphs.jsonl"])
 held = load_recordings([f"{CORPUS}/heldout_seed900/graphs.jsonl"])
 
 
+def validation_windows(ckpt: dict, rec: Recording):
+    """The windows of ``rec`` in the checkpoint's validation runs."""
+    windows = make_windows(rec, int(ckpt["window"]))
+    runs = list(ckpt["split_runs"]["val"])
+    return windows.subset(np.isin(np.asarray(rec.run_ids)[rec.run[windows.end]], runs))
+
+
 def score(ckpt: dict, c: np.ndarray, data: Recording, val_only: bool) -> np.ndarray:
     """Accuracy and localisation of ``ckpt`` told placement ``c`` (its sensors z-scored on the
     arm's healthy running) on ``data`` mixed by ``c``; ``val_only``: its validation runs."""
@@ -56,10 +63,7 @@ def score(ckpt: dict, c: np.ndarray, data: Recording, val_only: bool) -> np.ndar
     model = build(ckpt)
     model.anomaly.set_coupling(c)
     t = WindowTensors(graph.transform(rec.x), rec, mean, std, torch.device("cpu"))
-    windows = make_windows(rec, int(ckpt["window"]))
-    if val_only:
-        runs = list(ckpt["split_runs"]["val"])
-        windows = windows.subset(np.isin(np.asarray(rec.run_ids)[rec.run[windows.end]], runs))
+    windows = validation_windows(ckpt, rec) if val_only else make_windows(rec, int(ckpt["window"]))
     m = metrics_of(predict(model, t, windows))
     return np.array([m["accuracy"], m["localisation_accuracy"]])
 
@@ -78,10 +82,7 @@ def self_calibrated(
     rec = graph.relabel(data)
     t = WindowTensors(graph.transform(rec.x), rec, ckpt["norm_mean"].numpy(),
                       ckpt["norm_std"].numpy(), torch.device("cpu"))  # fmt: skip
-    windows = make_windows(rec, int(ckpt["window"]))
-    runs = list(ckpt["split_runs"]["val"])
-    windows = windows.subset(np.isin(np.asarray(rec.run_ids)[rec.run[windows.end]], runs))
-    m = metrics_of(predict(build(ckpt), t, windows))  # its C: the one commissioning fitted
+    m = metrics_of(predict(build(ckpt), t, validation_windows(ckpt, rec)))  # C: the fitted one
     return np.array([m["accuracy"], m["localisation_accuracy"]]), record["placement"][
         "coupling_correlation"
     ]

@@ -118,7 +118,7 @@ class STGNN(nn.Module):
         if not self.coupled_edges:
             return adj
         j = self.num_joints
-        block = adj[:, :j, j:]
+        block = adj[:, :j, j:]  # broadcast by a tensor op, not expand(b): ONNX keeps B dynamic
         c = self.anomaly.coupling() + torch.zeros_like(block) if coupling is None else coupling
         top = torch.cat([adj[:, :j, :j], c], dim=-1)
         bottom = torch.cat([c.transpose(1, 2), adj[:, j:, j:]], dim=-1)
