@@ -176,7 +176,8 @@ def _monitor_ros2(
                          evaluate if cfg.evaluate else None)  # fmt: skip
     for arm, c in counts.items():
         last = f" (last: {c['last_problem']})" if c["last_problem"] else ""
-        print(f"{arm}: {c['samples']} samples diagnosed, {c['problems']} bad inputs{last}")
+        print(f"{arm}: {c['samples']} samples diagnosed, {c['problems']} bad inputs, "
+              f"{c['late']} late, {c['duplicates']} duplicate messages{last}")  # fmt: skip
     if not cfg.evaluate:
         return None
     result = {arm: e.result() for arm, e in evaluators.items()}

@@ -3,10 +3,17 @@
 Stamped topics (joint states, tracking error, each IMU, the ground truth) are keyed by their
 header stamp, a vibration array by the stamp its layout carries (``stamp_ns=``); an array without
 one (another publisher's) queues in arrival order and the oldest goes with the oldest stamp. A stamp
-is emitted once every topic has its message, in stamp order. What goes wrong on a live bus is
-returned as a problem for that arm, never raised: a stamp older than one already emitted, a stamp
-whose messages stopped coming while newer ones completed (``late_ticks``), a message that does
-not assemble (wrong array length, unknown joint order, NaN), or a second message at one stamp.
+is emitted once every topic has its message, in stamp order.
+
+What goes wrong on a live bus is returned for that arm, never raised. Problems (bad input): a
+message that does not assemble (wrong array length, unknown joint order, NaN), a second,
+different message at one stamp, a stamp older than every recent one (the clock went back), and a
+tick whose messages stopped coming while newer ones completed. That last judgement is made only
+at a poll boundary (:meth:`ArmAssembler.settle`, once every reader has been taken): a monitor
+takes its topics one after another, so mid-poll the stamped topics of a long backlog are in while
+the arrays of the same ticks are still in their readers. Not problems, counted apart: a repeated
+identical message (``duplicates``: a re-delivery or re-publish) and a message for a tick already
+reported missing (``late``).
 """
 
 from __future__ import annotations
@@ -32,6 +39,8 @@ UNKNOWN_TRUTH = FaultLabel("none", None, 0.0, False)
 class Assembled:
     samples: list[GraphSample] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)
+    duplicates: int = 0  # repeated identical messages, dropped
+    late: int = 0  # messages for ticks already reported missing, dropped
 
 
 def _stamp_ns(msg: Any) -> int | None:
@@ -71,6 +80,10 @@ class ArmAssembler:
         self.pending: dict[int, dict[str, Any]] = {}
         self.queues: dict[str, deque] = {t: deque() for t in self.vibration}
         self.last_emitted: int | None = None
+        # the messages of the last settled (emitted or missed) ticks, to tell a duplicate or a
+        # late message from a stamp that went backwards
+        self.settled: dict[int, dict[str, Any]] = {}
+        self.settled_kept = max(4 * late_ticks, 32)
         self.count = 0
 
     def topic_names(self) -> list[str]:
@@ -88,20 +101,51 @@ class ArmAssembler:
                 out.problems.append(f"topic '{topic}': message without a header stamp")
                 return out
             if self.last_emitted is not None and stamp <= self.last_emitted:
-                out.problems.append(
-                    f"topic '{topic}': stamp {stamp / 1e9:.6f} s is not after the last sample "
-                    f"({self.last_emitted / 1e9:.6f} s): stamps went backwards"
-                )
+                self._settled_message(topic, stamp, msg, out)
                 return out
             slot = self.pending.setdefault(stamp, {})
             if topic in slot:
-                out.problems.append(
-                    f"topic '{topic}': a second message at stamp {stamp / 1e9:.6f} s"
-                )
+                self._repeated(topic, stamp, slot[topic], msg, out)
                 return out
             slot[topic] = msg
-        self._drain(out)
+        self._drain(out, drop_late=False)
         return out
+
+    def settle(self) -> Assembled:
+        """At a poll boundary: report the ticks that stay incomplete while ``late_ticks`` newer
+        ones have every stamped topic, and emit what waited behind them."""
+        out = Assembled()
+        self._drain(out, drop_late=True)
+        return out
+
+    def _repeated(self, topic: str, stamp: int, first: Any, msg: Any, out: Assembled) -> None:
+        if msg == first:
+            out.duplicates += 1
+        else:
+            out.problems.append(
+                f"topic '{topic}': a second, different message at stamp {stamp / 1e9:.6f} s"
+            )
+
+    def _settled_message(self, topic: str, stamp: int, msg: Any, out: Assembled) -> None:
+        """A message at or before the last emitted stamp: a duplicate of one already used, a
+        late one for a tick reported missing, or a stamp from before the recent ticks."""
+        slot = self.settled.get(stamp)
+        if slot is None:
+            out.problems.append(
+                f"topic '{topic}': stamp {stamp / 1e9:.6f} s is not after the last sample "
+                f"({self.last_emitted / 1e9:.6f} s): stamps went backwards"
+            )
+        elif topic in slot:
+            self._repeated(topic, stamp, slot[topic], msg, out)
+        else:
+            out.late += 1
+
+    def _settle(self, stamp: int, slot: dict[str, Any]) -> None:
+        del self.pending[stamp]
+        self.last_emitted = stamp
+        self.settled[stamp] = slot
+        while len(self.settled) > self.settled_kept:
+            del self.settled[min(self.settled)]
 
     def _stamped_in(self, slot: dict[str, Any]) -> bool:
         return all(t in slot for t in self.stamped)
@@ -109,31 +153,29 @@ class ArmAssembler:
     def _complete(self, slot: dict[str, Any]) -> bool:
         return self._stamped_in(slot) and all(t in slot or self.queues[t] for t in self.vibration)
 
-    def _drain(self, out: Assembled) -> None:
+    def _drain(self, out: Assembled, drop_late: bool) -> None:
         while self.pending:
             oldest = min(self.pending)
             slot = self.pending[oldest]
             if self._complete(slot):
-                del self.pending[oldest]
                 vibs = [slot[t] if t in slot else self.queues[t].popleft() for t in self.vibration]
-                self.last_emitted = oldest
+                self._settle(oldest, slot)
                 try:
                     out.samples.append(self._sample(oldest, slot, vibs))
                 except _Problem as exc:
                     out.problems.append(str(exc))
                 continue
+            if not drop_late:
+                return
             newer_complete = sum(
-                1
-                for s, sl in self.pending.items()
-                if s > oldest and all(t in sl for t in self.stamped)
+                1 for s, sl in self.pending.items() if s > oldest and self._stamped_in(sl)
             )
             if newer_complete < self.late_ticks:
                 return
             missing = [t for t in self.stamped if t not in slot] or [
                 t for t in self.vibration if t not in slot and not self.queues[t]
             ]
-            del self.pending[oldest]
-            self.last_emitted = oldest
+            self._settle(oldest, slot)
             out.problems.append(
                 f"topic '{missing[0]}' at stamp {oldest / 1e9:.6f} s: message missing "
                 f"({len(missing)} topics)"

@@ -89,7 +89,13 @@ def run_monitor(
             node.publish_diagnostics(time.time())  # the last word on every arm
             bus.close()
     return {
-        arm: {"samples": s.samples, "problems": s.problems, "last_problem": s.last_problem}
+        arm: {
+            "samples": s.samples,
+            "problems": s.problems,
+            "late": s.late,
+            "duplicates": s.duplicates,
+            "last_problem": s.last_problem,
+        }
         for arm, s in node.arms.items()
     }
 

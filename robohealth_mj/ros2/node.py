@@ -111,6 +111,8 @@ class ArmState:
     problem: str | None = None  # the latest, until /diagnostics has reported it
     last_problem: str | None = None
     problems: int = 0
+    duplicates: int = 0  # repeated identical messages (re-deliveries), dropped
+    late: int = 0  # messages for ticks already reported missing, dropped
     samples: int = 0
     diagnoses: list[Any] = field(default_factory=list)
 
@@ -172,14 +174,11 @@ class MonitorNode:
                 for msg in taken:
                     if not isinstance(msg, kind):
                         continue  # an instance-state notice (a writer went away), not data
-                    got = state.assembler.add(topic, msg)
-                    for problem in got.problems:
-                        state.problem = state.last_problem = problem
-                        state.problems += 1
-                    for sample in got.samples:
-                        submitted.append((arm, sample))
-                        state.last_sample_wall = now
+                    self._collect(arm, state, state.assembler.add(topic, msg), now, submitted)
                 self.seconds["assemble"] += clock() - t1
+            t1 = clock()  # every reader of the arm taken: now a missing message is missing
+            self._collect(arm, state, state.assembler.settle(), now, submitted)
+            self.seconds["assemble"] += clock() - t1
         t2 = clock()
         # One sample per arm per runtime step: every sample gets its own decision (a step given
         # several samples of one stream decides only the last), and the arms share each step.
@@ -201,6 +200,17 @@ class MonitorNode:
         self.seconds["publish"] += self._publishing
         self._publishing = 0.0
         return len(submitted)
+
+    @staticmethod
+    def _collect(arm: str, state: ArmState, got: Any, now: float, submitted: list) -> None:
+        for problem in got.problems:
+            state.problem = state.last_problem = problem
+            state.problems += 1
+        state.duplicates += got.duplicates
+        state.late += got.late
+        for sample in got.samples:
+            submitted.append((arm, sample))
+            state.last_sample_wall = now
 
     def _record(self, arm: str, d: Any, sample: GraphSample) -> None:
         state = self.arms[arm]
@@ -235,7 +245,8 @@ class MonitorNode:
         elif state.problem is not None:
             msg.level = max(int(msg.level), status.WARN)
             msg.message = f"bad input: {state.problem}"
-        msg.values.append(self.factory.KeyValue(key="problems", value=str(state.problems)))
+        for key in ("problems", "late", "duplicates"):
+            msg.values.append(self.factory.KeyValue(key=key, value=str(getattr(state, key))))
         return msg
 
     def check_writers(self) -> None:
