@@ -2,13 +2,14 @@
 #   make run    set up .venv and run the whole pipeline on the quick corpus: record, gate, train
 #               gbdt / mlp / anomaly_residual (structural graph), evaluate, print the results
 #               tables (about 9 minutes on 2 cores)
-#   make test   set up .venv and run the test suite
+#   make test   set up .venv and run the test suite (all of it; `make test-fast` skips the
+#               tests that train a model, for the loop while developing)
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
 
-.PHONY: setup run test bench lint format clean
+.PHONY: setup run test test-fast bench lint format clean
 
 setup: $(STAMP)
 
@@ -20,6 +21,8 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	# CPU build of torch first (a local file on these machines), so nothing pulls a CUDA build.
 	$(BIN)/python -m pip install --quiet torch==2.13.0
+	# The project with every extra (`full`: simulation, training, the live monitor) and the test
+	# tools; a deployment machine needs only `pip install '.[monitor]'` (no torch).
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	rm -f $(VENV)/.installed-* && touch $@
 
@@ -32,16 +35,19 @@ run: setup
 test: setup
 	$(BIN)/python -m pytest
 
+test-fast: setup
+	$(BIN)/python -m pytest -m "not slow"
+
 bench: setup
 	$(BIN)/python -m robohealth_mj.bench sim
 
 lint: setup
-	$(BIN)/ruff check robohealth_mj tests
-	$(BIN)/ruff format --check robohealth_mj tests
+	$(BIN)/ruff check robohealth_mj tests experiments
+	$(BIN)/ruff format --check robohealth_mj tests experiments
 
 format: setup
-	$(BIN)/ruff format robohealth_mj tests
-	$(BIN)/ruff check --fix robohealth_mj tests
+	$(BIN)/ruff format robohealth_mj tests experiments
+	$(BIN)/ruff check --fix robohealth_mj tests experiments
 
 clean:
 	rm -rf $(VENV) outputs .pytest_cache .ruff_cache

@@ -19,7 +19,7 @@ import sys
 from collections import Counter
 from pathlib import Path
 
-from robohealth_mj.errors import InputError, exit_status
+from robohealth_mj.common.errors import InputError, exit_status
 
 
 def _write(args: argparse.Namespace) -> int:

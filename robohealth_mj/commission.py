@@ -1,7 +1,7 @@
 """``python -m robohealth_mj.commission model=CKPT healthy=LOG_OR_DIR [out=DIR]``.
 
 Commissions a trained model on a new arm from minutes of its healthy running (no labels): the
-healthy baseline of the residual channels is refitted (:mod:`robohealth_mj.runtime.commission`),
+healthy baseline of the residual channels is refitted (:mod:`robohealth_mj.deploy.commission`),
 a new checkpoint and ONNX are written whose metadata records the commissioning data's
 fingerprint, and the table says after how many healthy minutes the baseline settled.
 """
@@ -13,10 +13,10 @@ from pathlib import Path
 
 from omegaconf import OmegaConf
 
-from robohealth_mj.atomic import atomic_write_json
-from robohealth_mj.config import load_cli_config
-from robohealth_mj.errors import InputError, one_line_errors
-from robohealth_mj.runtime.commission import SETTLED, commission
+from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.config import load_cli_config
+from robohealth_mj.common.errors import InputError, one_line_errors
+from robohealth_mj.deploy.commission import SETTLED, commission
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -33,12 +33,18 @@ import hydra
 from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
-from robohealth_mj.atomic import atomic_write_json
-from robohealth_mj.config import compose_config
-from robohealth_mj.errors import one_line_errors
-from robohealth_mj.recorder import GRAPHS_FILE, MANIFEST_FILE, default_run_id, record_session
+from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.config import compose_config
+from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.common.resources import HYDRA_CONF
+from robohealth_mj.common.version import code_version
+from robohealth_mj.recording.recorder import (
+    GRAPHS_FILE,
+    MANIFEST_FILE,
+    default_run_id,
+    record_session,
+)
 from robohealth_mj.schema import SCHEMA_VERSION
-from robohealth_mj.version import code_version
 
 CORPUS_INDEX = "corpus.json"
 
@@ -166,7 +172,7 @@ def build_corpus(
     return index
 
 
-@hydra.main(config_path="../conf", config_name="corpus", version_base="1.3")
+@hydra.main(config_path=HYDRA_CONF, config_name="corpus", version_base="1.3")
 def main(cfg: DictConfig) -> None:
     out_dir = Path(cfg.out_dir)
     jobs = cfg.jobs or os.cpu_count() or 1

@@ -14,8 +14,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from robohealth_mj.atomic import atomic_write_json
-from robohealth_mj.errors import exit_status
+from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.errors import exit_status
 
 
 def resolve(paths: list[str]) -> list[Path]:

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import argparse
 
-from robohealth_mj.effect_sizes import COLUMNS, sweep, table_row
 from robohealth_mj.faults.catalogue import FAULT_MODELS, MODES
+from robohealth_mj.recording.effect_sizes import COLUMNS, sweep, table_row
 from robohealth_mj.schema import JOINT_NAMES
 
 
@@ -60,7 +60,7 @@ def main(argv: list[str] | None = None) -> None:
                 flush=True,
             )
     if args.json:
-        from robohealth_mj.atomic import atomic_write_json
+        from robohealth_mj.common.atomic import atomic_write_json
 
         atomic_write_json(args.json, rows)
 

@@ -11,11 +11,12 @@ from pathlib import Path
 import hydra
 from omegaconf import DictConfig
 
-from robohealth_mj.errors import one_line_errors
+from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.common.resources import HYDRA_CONF
 from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 
 
-@hydra.main(config_path="../conf", config_name="evaluate", version_base="1.3")
+@hydra.main(config_path=HYDRA_CONF, config_name="evaluate", version_base="1.3")
 def main(cfg: DictConfig) -> None:
     if not cfg.ckpt or not cfg.data:
         raise SystemExit("usage: python -m robohealth_mj.evaluate ckpt=PATH data=PATH [out=PREFIX]")

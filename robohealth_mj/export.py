@@ -11,11 +11,12 @@ from pathlib import Path
 import hydra
 from omegaconf import DictConfig
 
-from robohealth_mj.errors import one_line_errors
-from robohealth_mj.runtime.export import export_checkpoint
+from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.common.resources import HYDRA_CONF
+from robohealth_mj.deploy.export import export_checkpoint
 
 
-@hydra.main(config_path="../conf", config_name="export", version_base="1.3")
+@hydra.main(config_path=HYDRA_CONF, config_name="export", version_base="1.3")
 def main(cfg: DictConfig) -> None:
     if not cfg.ckpt:
         raise SystemExit("usage: python -m robohealth_mj.export ckpt=PATH [out=model.onnx]")

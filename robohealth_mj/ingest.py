@@ -18,15 +18,15 @@ import os
 import tempfile
 from pathlib import Path
 
-from robohealth_mj.atomic import atomic_write_json
-from robohealth_mj.errors import exit_status
+from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.errors import exit_status
 
 
 def ingest(log: Path, column_map: str | None, out: Path, tick_hz: float) -> dict:
     """Write ``out/graphs.jsonl`` and ``out/manifest.json`` (each atomically); the manifest."""
+    from robohealth_mj.common.version import code_version
     from robohealth_mj.data.jsonl import format_line
     from robohealth_mj.logs.convert import convert_log, session_samples
-    from robohealth_mj.version import code_version
 
     cmap, sessions = convert_log(log, column_map, tick_hz)
     out.mkdir(parents=True, exist_ok=True)

@@ -22,19 +22,19 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from robohealth_mj.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.bags import is_bag
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.bags.writer import BagWriter
-from robohealth_mj.config import load_cli_config
+from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
+from robohealth_mj.common.config import load_cli_config
+from robohealth_mj.common.errors import InputError, one_line_errors
 from robohealth_mj.data.read import recording_sensing
 from robohealth_mj.data.sensing import refuse_missing_channels
-from robohealth_mj.errors import InputError, one_line_errors
 from robohealth_mj.reporting.online import online_markdown
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
-from robohealth_mj.runtime.export import read_metadata
 from robohealth_mj.runtime.fleet import freeze_startup_heap
+from robohealth_mj.runtime.metadata import read_metadata
 from robohealth_mj.runtime.online_eval import OnlineEvaluator, joint_activity
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 from robohealth_mj.runtime.sources import replay_stream, sim_stream

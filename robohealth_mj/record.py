@@ -13,11 +13,12 @@ import hydra
 from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
-from robohealth_mj.errors import one_line_errors
-from robohealth_mj.recorder import record_session, summary_text
+from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.common.resources import HYDRA_CONF
+from robohealth_mj.recording.recorder import record_session, summary_text
 
 
-@hydra.main(config_path="../conf", config_name="record", version_base="1.3")
+@hydra.main(config_path=HYDRA_CONF, config_name="record", version_base="1.3")
 def main(cfg: DictConfig) -> None:
     out_dir = cfg.session.out_dir or HydraConfig.get().runtime.output_dir
     with one_line_errors("record"):

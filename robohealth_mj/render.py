@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 from omegaconf import DictConfig
 
-from robohealth_mj.config import compose_config, load_cli_config
-from robohealth_mj.errors import one_line_errors
-from robohealth_mj.runtime.export import read_metadata
+from robohealth_mj.common.config import compose_config, load_cli_config
+from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.runtime.metadata import read_metadata
 
 
 def load_config(argv: list[str]) -> DictConfig:
@@ -44,8 +44,8 @@ def render_episode(cfg: DictConfig) -> list:
     from PIL import Image
 
     from robohealth_mj.data.jsonl import format_line
-    from robohealth_mj.recorder import build_simulator, chunk_features
-    from robohealth_mj.runtime.render import EpisodeRenderer, write_video
+    from robohealth_mj.deploy.render import EpisodeRenderer, write_video
+    from robohealth_mj.recording.recorder import build_simulator, chunk_features
     from robohealth_mj.runtime.runtime import ModelRuntime
 
     record = compose_config(

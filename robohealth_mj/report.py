@@ -18,9 +18,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from robohealth_mj.errors import InputError, one_line_errors
-from robohealth_mj.reporting import build_report
+from robohealth_mj.common.errors import InputError, one_line_errors
 from robohealth_mj.reporting.archive import archive_runs
+from robohealth_mj.reporting.build import build_report
 
 __all__ = ["build_report", "main"]
 

@@ -14,8 +14,8 @@ import sys
 from pathlib import Path
 
 from robohealth_mj.bags import is_bag
-from robohealth_mj.config import load_cli_config
-from robohealth_mj.errors import InputError, one_line_errors
+from robohealth_mj.common.config import load_cli_config
+from robohealth_mj.common.errors import InputError, one_line_errors
 
 
 def main(argv: list[str] | None = None) -> int:

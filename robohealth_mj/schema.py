@@ -46,6 +46,17 @@ FEATURE_NAMES: tuple[str, ...] = ("is_joint", "is_sensor", *STATE_FEATURES, *SEN
 N_JOINTS = len(JOINT_NAMES)
 N_NODES = len(NODE_NAMES)
 N_FEATURES = len(FEATURE_NAMES)
+# The per-channel statistics a model pools each window into (models/statistics.py computes them in
+# torch, runtime/incremental.py from running sums; both read the names here).
+WINDOW_STATISTICS: tuple[str, ...] = (
+    "mean",
+    "std",
+    "min",
+    "max",
+    "last_minus_first",
+    "mean_abs_step",
+    "max_abs_step",
+)
 STATE_CHANNELS = slice(2, 2 + len(STATE_FEATURES))
 SENSOR_CHANNELS = slice(STATE_CHANNELS.stop, N_FEATURES)
 

@@ -17,8 +17,9 @@ import hydra
 from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
-from robohealth_mj.config import register_resolvers
-from robohealth_mj.errors import one_line_errors
+from robohealth_mj.common.config import register_resolvers
+from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.common.resources import HYDRA_CONF
 from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 from robohealth_mj.learn.trainer import CHECKPOINT, finished_on_current_data, train_run
 
@@ -48,7 +49,7 @@ def run(cfg: DictConfig, out_dir: Path) -> dict:
 register_resolvers()
 
 
-@hydra.main(config_path="../conf", config_name="train", version_base="1.3")
+@hydra.main(config_path=HYDRA_CONF, config_name="train", version_base="1.3")
 def main(cfg: DictConfig) -> None:
     with one_line_errors("train"):
         run(cfg, Path(cfg.out_dir or HydraConfig.get().runtime.output_dir))

@@ -5,7 +5,7 @@ The model's decisions are computed once (``--healthy``: also on a healthy-only s
 false alarms per hour rest on hours, not minutes), then every policy of the grid replays over
 them; the
 table (markdown) lists each policy's detection rate, false alarms and latency, and the last line
-names the chosen policy (see :func:`~robohealth_mj.runtime.alarm_sweep.choose`). Put it in
+names the chosen policy (see :func:`~robohealth_mj.deploy.alarm_sweep.choose`). Put it in
 ``conf/monitor.yaml``'s ``evidence`` and ``alarm`` blocks. The grid covers memory (``evidence``:
 how window probabilities accumulate) and the alarm's debouncing together, since each changes
 what the other should be.
@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import argparse
 
-from robohealth_mj.errors import one_line_errors
-from robohealth_mj.runtime.alarm_sweep import choose, meets_targets, replay_decisions, sweep
+from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.deploy.alarm_sweep import choose, meets_targets, replay_decisions, sweep
 
 
 def _f(value: float | None) -> str:

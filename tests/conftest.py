@@ -17,9 +17,19 @@ from pathlib import Path
 
 import pytest
 
-from robohealth_mj.config import compose_config
+from robohealth_mj.common.config import compose_config
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.sim.model import build_model
+
+# Tests that read a model trained for the session are ``slow`` (so are those that train in their
+# own body, marked where they are): ``pytest -m "not slow"`` is the quick loop while developing.
+TRAINED_FIXTURES = frozenset({"deployed", "stock_deployed"})
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        if TRAINED_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.slow)
 
 
 @pytest.fixture(scope="session")
@@ -98,7 +108,7 @@ def cached(tmp_path_factory, name: str, build: Callable[[Path], dict]) -> dict:
 
 def _recorder(overrides: list[str], sessions: dict[str, int]) -> Callable[[Path], dict]:
     def record(root: Path) -> dict:
-        from robohealth_mj.recorder import record_session
+        from robohealth_mj.recording.recorder import record_session
 
         for name, seed in sessions.items():
             record_session(compose_config("record", [*overrides, f"seed={seed}"]), root / name)
@@ -138,7 +148,7 @@ def _tiny_train_config(corpus: Path, *overrides: str):
 
 
 def _train_and_export(corpus: Path, root: Path) -> dict:
-    from robohealth_mj.runtime.export import export_checkpoint
+    from robohealth_mj.deploy.export import export_checkpoint
     from robohealth_mj.train import run
 
     paths = {"root": str(corpus), "heldout": str(corpus / "heldout" / "graphs.jsonl")}
@@ -170,7 +180,7 @@ def deployed(tmp_path_factory, learnable_corpus) -> dict[str, Path]:
 
 
 def _train_stock(corpus: Path, root: Path) -> dict:
-    from robohealth_mj.runtime.export import export_checkpoint
+    from robohealth_mj.deploy.export import export_checkpoint
     from robohealth_mj.train import run
 
     cfg = _tiny_train_config(

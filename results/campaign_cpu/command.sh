@@ -4,7 +4,7 @@
 cd "$(dirname "$0")/../.." && . .venv/bin/activate
 python -c "
 from robohealth_mj.data.arrays import load_recordings
-from robohealth_mj.learn.trainer import expand_paths
+from robohealth_mj.data.arrays import expand_paths
 load_recordings(expand_paths(['outputs/corpus/standard/train_*']))
 load_recordings(expand_paths(['outputs/corpus/standard/heldout_seed900']))
 load_recordings(expand_paths(['outputs/corpus/standard/probe_payload_high_seed901']))

@@ -9,15 +9,15 @@ export ROBOHEALTH_TEST_CACHE=${ROBOHEALTH_TEST_CACHE:-/tmp/robohealth_fixtures}
 # stopped the fleet module after the mutants below, then named them explicitly:
 #   .venv/bin/mutmut run --max-children 2 NAME ...
 .venv/bin/mutmut run --max-children 2
-.venv/bin/mutmut results --all true | python results/mutation/tabulate.py
+.venv/bin/mutmut results --all true | python experiments/mutation/tabulate.py
 # One mutant in four (the before/after comparison):
 .venv/bin/mutmut results --all true | awk -F': ' '{print $1}' | sed 's/^ *//' \
   | awk -F'__mutmut_' '$2 % 4 == 0' > /tmp/sample.txt
-.venv/bin/mutmut results --all true | python results/mutation/tabulate.py --sample 4
+.venv/bin/mutmut results --all true | python experiments/mutation/tabulate.py --sample 4
 
 # Before: the tests of commit 40376a8 on the same sample, in a worktree whose conftest's
 # `deployed` and test_training's `tiny_corpus` read the same on-disk cache, and whose
 # [tool.mutmut] lists only the test files that existed then:
 #   git worktree add /tmp/before 40376a8 && cd /tmp/before   # (those two edits)
 #   mutmut run --max-children 2 $(cat /tmp/sample.txt)
-#   mutmut results --all true | python results/mutation/tabulate.py --sample 4
+#   mutmut results --all true | python experiments/mutation/tabulate.py --sample 4

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # On-line alarms of the stock headline (stgnn_fixed, seed 42) on the three probe sessions: run by
 # the nominal arm, by each unseen arm, and by each unseen arm after commissioning on ten minutes of
-# its healthy running. Writes outputs/unseen_arms/monitor/*.json; results/stock/unseen_arms.py
+# its healthy running. Writes outputs/unseen_arms/monitor/*.json; experiments/stock/unseen_arms.py
 # puts them in its table. Usage: bash results/stock/alarms.sh [CORPUS]
 set -euo pipefail
 C=${1:-outputs/corpus/standard}

@@ -5,9 +5,9 @@ CORPUS=${CORPUS:-outputs/corpus/standard}
 PY=.venv/bin/python
 $PY -m robohealth_mj.corpus corpus=standard progress=false          # with the unseen-arm/program roles
 CORPUS=$CORPUS bash results/thesis_physics/command.sh stock matrix_w32   # 3 seeds each, W = 32
-$PY results/stock/compare.py                                        # -> stock_vs_full.md
-$PY results/stock/unseen_arms.py "$CORPUS"                          # -> unseen_arms.md
-bash results/stock/alarms.sh "$CORPUS" && $PY results/stock/unseen_arms.py "$CORPUS"
+$PY experiments/stock/compare.py                                        # -> stock_vs_full.md
+$PY experiments/stock/unseen_arms.py "$CORPUS"                          # -> unseen_arms.md
+bash results/stock/alarms.sh "$CORPUS" && $PY experiments/stock/unseen_arms.py "$CORPUS"
 # An unseen program: ten minutes of its healthy running to commission on, then the table.
 $PY -m robohealth_mj.record seed=950 faults=none session.duration_s=600 \
   'curriculum.families=[pick_place]' 'curriculum.speed_scales=[0.6,1.0,1.5]' \
@@ -15,9 +15,9 @@ $PY -m robohealth_mj.record seed=950 faults=none session.duration_s=600 \
   session.out_dir="$CORPUS/healthy_program_seed950"
 # The operating-point recipe, chosen on the program's validation session (seed 932), then the
 # probe sessions (930-931) with it, and where the headline still loses accuracy there.
-$PY results/stock/operating_point_recipe.py "$CORPUS"               # -> operating_point_recipe.md
-$PY results/stock/unseen_program.py "$CORPUS"                       # -> unseen_program.md
-$PY results/stock/program_strata.py "$CORPUS" > results/stock/program_strata.md
+$PY experiments/stock/operating_point_recipe.py "$CORPUS"               # -> operating_point_recipe.md
+$PY experiments/stock/unseen_program.py "$CORPUS"                       # -> unseen_program.md
+$PY experiments/stock/program_strata.py "$CORPUS" > results/stock/program_strata.md
 # Placement self-calibration (retrofit harness, W = 32, seed 42): models trained under 256 drawn
 # placements, models trained on each test placement (the references), then commissioning on ten
 # healthy minutes of the nominal arm.
@@ -46,7 +46,7 @@ S=outputs/selfcal
     data.evaluate.probe=null trainer.threads=1 trainer.placement_noise=0.3 \
     out_dir=$S/pool256_e40_edges_joint_placed_noise03
 }
-CORPUS=$CORPUS THREADS=2 $PY results/stock/pool_design.py dense=$S/pool256_e40/best.ckpt \
+CORPUS=$CORPUS THREADS=2 $PY experiments/stock/pool_design.py dense=$S/pool256_e40/best.ckpt \
   edges=$S/pool256_e40_edges/best.ckpt joint_scores=$S/pool256_e40_joint/best.ckpt \
   edges+joint_scores=$S/pool256_e40_edges_joint/best.ckpt \
   joint_scores+placement_embedding=$S/pool256_e40_joint_placed/best.ckpt \
@@ -58,10 +58,10 @@ $PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs=2 train
   hydra.sweep.dir=outputs/thesis_physics $D data.evaluate.probe=$CORPUS/probe_payload_high_seed901 \
   +experiment=placements sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy \
   graph.coupling_sensors=4 graph.coupling_seed=2,5,21,22,23
-CORPUS=$CORPUS $PY results/stock/self_calibration.py $S/pool256_e40_edges_joint_placed/best.ckpt \
+CORPUS=$CORPUS $PY experiments/stock/self_calibration.py $S/pool256_e40_edges_joint_placed/best.ckpt \
   outputs/thesis_physics/harness/retrofit/C0/anomaly_residual/w32/seed42/best.ckpt \
   > results/stock/self_calibration.md
-CORPUS=$CORPUS $PY results/stock/self_calibration.py $S/pool256_e40/best.ckpt \
+CORPUS=$CORPUS $PY experiments/stock/self_calibration.py $S/pool256_e40/best.ckpt \
   > results/stock/self_calibration_dense_pool.md
 # A second seed of the chosen pool model and of the trained-on-placement references.
 # shellcheck disable=SC2086
@@ -72,16 +72,16 @@ $PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs=2 train
   hydra.sweep.dir=outputs/thesis_physics $D data.evaluate.probe=$CORPUS/probe_payload_high_seed901 \
   +experiment=placements sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy \
   graph.coupling_sensors=4 graph.coupling_seed=2,5,21,22,23 seed=43
-CORPUS=$CORPUS $PY results/stock/self_calibration.py $S/self_calibrating_seed43/best.ckpt \
+CORPUS=$CORPUS $PY experiments/stock/self_calibration.py $S/self_calibrating_seed43/best.ckpt \
   outputs/thesis_physics/harness/retrofit/C0/anomaly_residual/w32/seed43/best.ckpt \
   > results/stock/self_calibration_seed43.md
 # Ablation: a model trained from scratch on the placement the motion fit found (the rest as the
 # trained-on-placement references), scored on the held-out session mixed by the true placement.
-CORPUS=$CORPUS $PY results/stock/self_calibration_retrain.py estimate outputs/selfcal/pool256_e40/best.ckpt
+CORPUS=$CORPUS $PY experiments/stock/self_calibration_retrain.py estimate outputs/selfcal/pool256_e40/best.ckpt
 for s in 2 5 21 22 23; do
   # shellcheck disable=SC2086
   $PY -m robohealth_mj.train sensing=retrofit trainer.threads=1 $D data.evaluate.probe=null \
     +experiment=placements variant=anomaly_residual model.anomaly_scores=energy \
     graph.coupling_file=outputs/selfcal/estimated/seed$s.json out_dir=outputs/selfcal/retrained/seed$s
 done
-CORPUS=$CORPUS $PY results/stock/self_calibration_retrain.py > results/stock/self_calibration_retrain.md
+CORPUS=$CORPUS $PY experiments/stock/self_calibration_retrain.py > results/stock/self_calibration_retrain.md

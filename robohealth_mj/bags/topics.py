@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from omegaconf import OmegaConf
 
-from robohealth_mj.config import CONF_DIR
+from robohealth_mj.common.resources import conf_dir
 from robohealth_mj.schema import JOINT_NAMES
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -29,7 +29,7 @@ class BagTopics:
     @classmethod
     def load(cls, **overrides: str) -> BagTopics:
         """``conf/bag.yaml`` with ``overrides``."""
-        names = dict(OmegaConf.to_container(OmegaConf.load(CONF_DIR / "bag.yaml")))
+        names = dict(OmegaConf.to_container(OmegaConf.load(conf_dir() / "bag.yaml")))
         names.update({k: v for k, v in overrides.items() if v})
         return cls(**names)
 

@@ -36,7 +36,7 @@ def fresh_variant(name: str, window: int, *overrides: str):
     """A freshly initialised model of a variant as ``train`` composes it (model + backbone) on
     the schema graph."""
     from robohealth_mj import schema
-    from robohealth_mj.config import compose_config
+    from robohealth_mj.common.config import compose_config
     from robohealth_mj.models import build_model
 
     cfg = compose_config("train", [f"variant={name}", *overrides])

@@ -14,8 +14,7 @@ from robohealth_mj.runtime.fleet import FleetRuntime, freeze_startup_heap
 
 
 def _frames(data: list[str]):
-    from robohealth_mj.data.arrays import load_recordings
-    from robohealth_mj.learn.trainer import expand_paths
+    from robohealth_mj.data.arrays import expand_paths, load_recordings
 
     return load_recordings(expand_paths(data)).x
 

@@ -18,11 +18,10 @@ def bench_infer(data: list[str], variants: list[str], window: int, batch: int) -
     import torch
     from torch.utils.flop_counter import FlopCounterMode
 
-    from robohealth_mj.data.arrays import load_recordings
+    from robohealth_mj.data.arrays import expand_paths, load_recordings
     from robohealth_mj.data.windows import make_windows, normalisation
-    from robohealth_mj.learn.trainer import expand_paths
+    from robohealth_mj.deploy.export import RawInput, attach_metadata, model_metadata
     from robohealth_mj.models.onnx import export_onnx
-    from robohealth_mj.runtime.export import RawInput, attach_metadata, model_metadata
 
     rec = load_recordings(expand_paths(data))
     windows = make_windows(rec, window)
@@ -105,11 +104,10 @@ def bench_deployed(model_path: str, data: list[str], batch: int) -> dict:
     import torch
     from torch.utils.flop_counter import FlopCounterMode
 
-    from robohealth_mj.data.arrays import load_recordings
+    from robohealth_mj.data.arrays import expand_paths, load_recordings
     from robohealth_mj.data.windows import make_windows
-    from robohealth_mj.learn.trainer import expand_paths
-    from robohealth_mj.runtime.export import read_metadata
     from robohealth_mj.runtime.fleet import FleetRuntime
+    from robohealth_mj.runtime.metadata import read_metadata
 
     meta = read_metadata(model_path)
     window = int(meta["window"])

@@ -7,8 +7,8 @@ import time
 
 import mujoco
 
-from robohealth_mj.config import compose_config
-from robohealth_mj.recorder import build_simulator, record_session
+from robohealth_mj.common.config import compose_config
+from robohealth_mj.recording.recorder import build_simulator, record_session
 
 
 def raw_step_rate(model: mujoco.MjModel, data: mujoco.MjData, seconds: float = 3.0) -> float:

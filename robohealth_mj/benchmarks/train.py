@@ -16,12 +16,11 @@ def bench_train(
     import torch
     from torch.utils.flop_counter import FlopCounterMode
 
-    from robohealth_mj.config import compose_config
-    from robohealth_mj.data.arrays import load_recordings
+    from robohealth_mj.common.config import compose_config
+    from robohealth_mj.data.arrays import expand_paths, load_recordings
     from robohealth_mj.data.windows import make_windows, normalisation
     from robohealth_mj.learn.data import WindowTensors
     from robohealth_mj.learn.loss import loss_from_config
-    from robohealth_mj.learn.trainer import expand_paths
 
     t0 = time.perf_counter()
     rec = load_recordings(expand_paths(data))
@@ -87,7 +86,7 @@ def bench_headline(overrides: list[str]) -> dict:
     import tempfile
     from pathlib import Path
 
-    from robohealth_mj.config import compose_config
+    from robohealth_mj.common.config import compose_config
     from robohealth_mj.train import run
 
     cfg = compose_config("train", ["trainer.progress=false", "skip_done=false", *overrides])

@@ -6,6 +6,7 @@ version; any mismatch re-parses (and re-validates) the JSONL. Written atomically
 
 from __future__ import annotations
 
+import glob
 import hashlib
 import io
 import json
@@ -14,9 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from robohealth_mj.atomic import atomic_write_bytes
+from robohealth_mj.common.atomic import atomic_write_bytes
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.read import is_bag, read_samples
-from robohealth_mj.errors import InputError
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, SCHEMA_VERSION
 
 CACHE_SUFFIX = ".cache.npz"
@@ -147,3 +148,15 @@ def resolve_recordings(paths: list[str] | str) -> list[Path]:
         else:
             raise FileNotFoundError(f"no recording at {raw}")
     return out
+
+
+def expand_paths(patterns: list[str] | str) -> list[Path]:
+    """Paths, session dirs and glob patterns -> recording files (sorted, each once)."""
+    patterns = [patterns] if isinstance(patterns, str) else list(patterns)
+    found: list[str] = []
+    for pattern in patterns:
+        matches = sorted(glob.glob(pattern)) if any(c in pattern for c in "*?[") else [pattern]
+        if not matches:
+            raise FileNotFoundError(f"no recordings match {pattern!r}")
+        found += matches
+    return list(dict.fromkeys(resolve_recordings(found)))

@@ -13,8 +13,8 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.baseline import shift
-from robohealth_mj.errors import InputError
 
 # Every joint reaches at least one sensor, and every joint's row is distinct, so the six joints
 # stay distinguishable from four sensors.

@@ -11,10 +11,10 @@ import os
 import tempfile
 from pathlib import Path
 
-from robohealth_mj.atomic import atomic_write_json
+from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.version import code_version
 from robohealth_mj.data.read import read_samples
 from robohealth_mj.schema import SCHEMA_VERSION
-from robohealth_mj.version import code_version
 
 
 def merge_files(sources: list[Path], out: Path) -> dict:

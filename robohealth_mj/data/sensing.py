@@ -21,8 +21,8 @@ import numpy as np
 import yaml
 
 from robohealth_mj import schema
-from robohealth_mj.config import CONF_DIR
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.resources import conf_dir
 
 
 @dataclass(frozen=True)
@@ -77,7 +77,7 @@ class SensingProfile:
 
 def load_profile(name: str) -> SensingProfile:
     """The profile ``conf/sensing/<name>.yaml`` (what a model's or a recording's name means)."""
-    path = CONF_DIR / "sensing" / f"{name}.yaml"
+    path = conf_dir() / "sensing" / f"{name}.yaml"
     if not path.is_file():
         raise InputError(f"no sensing profile {name!r} ({path} missing)")
     raw = yaml.safe_load(path.read_text())

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import Recording
-from robohealth_mj.errors import InputError
 from robohealth_mj.schema import feature_index
 
 

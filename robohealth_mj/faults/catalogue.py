@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, FaultLabel
 
 MODES: tuple[str, ...] = FAULT_CLASSES[1:]

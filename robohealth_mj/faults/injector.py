@@ -13,7 +13,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.faults.catalogue import FAULT_MODELS, MECHANICAL, FaultParameters
 from robohealth_mj.faults.mechanical import DriveFaults
 from robohealth_mj.faults.readings import ReadingFaults, TickReadings

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.faults.catalogue import MODES, Scenario
 from robohealth_mj.schema import JOINT_NAMES
 

@@ -17,9 +17,9 @@ import torch
 from torch import nn
 
 from robohealth_mj import schema
-from robohealth_mj.atomic import atomic_write_bytes
+from robohealth_mj.common.atomic import atomic_write_bytes
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.graphs import GraphSpec
-from robohealth_mj.errors import InputError
 from robohealth_mj.models import build_model
 
 FORMAT = "robohealth_mj.checkpoint/1"

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from robohealth_mj.atomic import atomic_write_json, atomic_write_text
-from robohealth_mj.data.arrays import load_recordings
+from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
+from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.data.windows import make_windows, target_joint_moved
 from robohealth_mj.learn.checkpoint import (
     check_recordings,
@@ -18,15 +18,9 @@ from robohealth_mj.learn.checkpoint import (
     model_from_checkpoint,
 )
 from robohealth_mj.learn.data import WindowTensors
-from robohealth_mj.learn.metrics import flat_rows
+from robohealth_mj.learn.metrics import flat_rows, metrics_of
 from robohealth_mj.learn.predict import Predictions, predict
-from robohealth_mj.learn.trainer import (
-    coupling_report,
-    expand_paths,
-    gamma_of,
-    metrics_of,
-    pick_device,
-)
+from robohealth_mj.learn.trainer import coupling_report, gamma_of, pick_device
 
 
 @dataclass

@@ -6,12 +6,15 @@ the injected joint, on windows whose final snapshot has an active fault.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from sklearn.metrics import confusion_matrix, precision_recall_fscore_support
 
 from robohealth_mj.schema import FAULT_CLASSES
+
+if TYPE_CHECKING:
+    from robohealth_mj.learn.predict import Predictions
 
 
 def _scalar_metrics(
@@ -104,3 +107,17 @@ def flat_rows(metrics: dict[str, Any], prefix: str = "") -> list[tuple[str, Any]
         elif isinstance(value, int | float):
             rows.append((name, value))
     return rows
+
+
+def metrics_of(pred: Predictions, target_moving: np.ndarray | None = None) -> dict[str, Any]:
+    """The metric set of one model's predictions (argmax class and joint)."""
+    return compute_metrics(
+        pred.class_logits.argmax(1),
+        pred.joint_logits.argmax(1),
+        pred.true_class,
+        pred.true_joint,
+        pred.active,
+        pred.true_severity,
+        pred.severity,
+        target_moving,
+    )

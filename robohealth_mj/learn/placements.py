@@ -1,5 +1,5 @@
 """Training under drawn placements: a coupling-head model that can later be recalibrated to a
-placement nobody measured (commissioning, :mod:`robohealth_mj.runtime.commission`).
+placement nobody measured (commissioning, :mod:`robohealth_mj.deploy.commission`).
 
 A model trained on one harness placement learns that placement into everything it has (the
 sensor nodes' embeddings, the predictor ``f``), so refitting ``C`` alone on another placement
@@ -12,12 +12,15 @@ statistics commissioning can refit from an arm's healthy running alone.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import torch
 
 from robohealth_mj import schema
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.graphs import GraphSpec, random_coupling
-from robohealth_mj.errors import InputError
+from robohealth_mj.data.windows import covered
 from robohealth_mj.models.heads import COUPLING_FLOOR
 
 POOL_SEED = 10_000  # pool placements come from seeds POOL_SEED + k: apart from campaign seeds
@@ -116,3 +119,27 @@ class PlacementPool:
         found = torch.where(reached, c * torch.exp(s * scale), s * value)
         keep = torch.where(reached, ~(weaker & (coin < s / 2)), coin < s / 2)
         return (found * keep).clamp_min(COUPLING_FLOOR)
+
+
+def placement_pool(
+    graph: GraphSpec, rec, train: Any, size: int, device, noise: float = 0.0
+) -> PlacementPool:
+    """The pool of drawn placements and the packages they mix (the profile's channels), with
+    the healthy training snapshots that z-score them."""
+    x = rec.x if graph.channel_mask is None else rec.x * graph.channel_mask
+    healthy = covered(train, len(rec)) & ~rec.active
+    return PlacementPool(graph, x, healthy, size, device, noise)
+
+
+def given_placement(model, graph: GraphSpec, pool: PlacementPool, mean, std) -> None:
+    """A model trained under drawn placements is given its graph's own placement (its ``C``
+    is set, not learned: validation and the checkpoint use it), and that placement's sensors
+    are z-scored on the healthy statistics the pool uses for every other placement."""
+    head = getattr(model, "anomaly", None)
+    if head is None:
+        raise InputError("trainer.placements needs a coupling-head variant (anomaly_residual)")
+    head.set_coupling(graph.coupling)
+    head.coupling_logits.requires_grad_(False)
+    j = graph.num_joints
+    mu, sd = pool.statistics(np.asarray(graph.coupling))
+    mean[j:, schema.SENSOR_CHANNELS], std[j:, schema.SENSOR_CHANNELS] = mu, sd

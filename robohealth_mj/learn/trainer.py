@@ -5,7 +5,6 @@ One seed controls Python, NumPy, PyTorch (initialisation, batch order, dropout) 
 
 from __future__ import annotations
 
-import glob
 import json
 import math
 import random
@@ -21,19 +20,18 @@ from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
 from robohealth_mj import schema
-from robohealth_mj.atomic import atomic_write_json
-from robohealth_mj.data.arrays import load_recordings, resolve_recordings
+from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.version import code_version
+from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.data.graphs import GraphSpec, coupling_correlation, placement_name
-from robohealth_mj.data.windows import covered, make_windows, normalisation, run_aware_split
-from robohealth_mj.errors import InputError
+from robohealth_mj.data.windows import make_windows, normalisation, run_aware_split
 from robohealth_mj.learn.checkpoint import save_checkpoint
 from robohealth_mj.learn.data import WindowTensors
 from robohealth_mj.learn.loss import loss_from_config
-from robohealth_mj.learn.metrics import compute_metrics
-from robohealth_mj.learn.placements import PlacementPool
-from robohealth_mj.learn.predict import Predictions, predict
+from robohealth_mj.learn.metrics import metrics_of
+from robohealth_mj.learn.placements import PlacementPool, given_placement, placement_pool
+from robohealth_mj.learn.predict import predict
 from robohealth_mj.models import build_model
-from robohealth_mj.version import code_version
 
 CHECKPOINT = "best.ckpt"
 
@@ -48,18 +46,6 @@ def pick_device(name: str) -> torch.device:
     if name == "auto":
         return torch.device("cuda" if torch.cuda.is_available() else "cpu")
     return torch.device(name)
-
-
-def expand_paths(patterns: list[str] | str) -> list[Path]:
-    """Paths, session dirs and glob patterns -> recording files (sorted, each once)."""
-    patterns = [patterns] if isinstance(patterns, str) else list(patterns)
-    found: list[str] = []
-    for pattern in patterns:
-        matches = sorted(glob.glob(pattern)) if any(c in pattern for c in "*?[") else [pattern]
-        if not matches:
-            raise FileNotFoundError(f"no recordings match {pattern!r}")
-        found += matches
-    return list(dict.fromkeys(resolve_recordings(found)))
 
 
 def finished_on_current_data(cfg: DictConfig, out_dir: Path) -> bool:
@@ -85,19 +71,6 @@ def finished_on_current_data(cfg: DictConfig, out_dir: Path) -> bool:
     except (OSError, ValueError, KeyError):
         return False
     return bool(fresh)
-
-
-def metrics_of(pred: Predictions, target_moving: np.ndarray | None = None) -> dict[str, Any]:
-    return compute_metrics(
-        pred.class_logits.argmax(1),
-        pred.joint_logits.argmax(1),
-        pred.true_class,
-        pred.true_joint,
-        pred.active,
-        pred.true_severity,
-        pred.severity,
-        target_moving,
-    )
 
 
 def coupling_report(model: torch.nn.Module, graph: GraphSpec) -> dict[str, Any]:
@@ -163,30 +136,6 @@ def prepare(cfg: DictConfig) -> Prepared:
         given_placement(model, graph, pool, mean, std)
     tensors = WindowTensors(x, rec, mean, std, device)
     return Prepared(cfg, graph, rec, splits, mean, std, tensors, model, device, pool)
-
-
-def placement_pool(
-    graph: GraphSpec, rec, train: Any, size: int, device, noise: float = 0.0
-) -> PlacementPool:
-    """The pool of drawn placements and the packages they mix (the profile's channels), with
-    the healthy training snapshots that z-score them."""
-    x = rec.x if graph.channel_mask is None else rec.x * graph.channel_mask
-    healthy = covered(train, len(rec)) & ~rec.active
-    return PlacementPool(graph, x, healthy, size, device, noise)
-
-
-def given_placement(model, graph: GraphSpec, pool: PlacementPool, mean, std) -> None:
-    """A model trained under drawn placements is given its graph's own placement (its ``C``
-    is set, not learned: validation and the checkpoint use it), and that placement's sensors
-    are z-scored on the healthy statistics the pool uses for every other placement."""
-    head = getattr(model, "anomaly", None)
-    if head is None:
-        raise InputError("trainer.placements needs a coupling-head variant (anomaly_residual)")
-    head.set_coupling(graph.coupling)
-    head.coupling_logits.requires_grad_(False)
-    j = graph.num_joints
-    mu, sd = pool.statistics(np.asarray(graph.coupling))
-    mean[j:, schema.SENSOR_CHANNELS], std[j:, schema.SENSOR_CHANNELS] = mu, sd
 
 
 def _save(p: Prepared, out_dir: Path, best_epoch: int, gamma: float | None) -> None:

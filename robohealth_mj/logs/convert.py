@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.jsonl import node_features
-from robohealth_mj.errors import InputError
 from robohealth_mj.logs.maps import UNITS, ColumnMap, detect_map, load_map
 from robohealth_mj.logs.tables import Table, read_header, read_table
 

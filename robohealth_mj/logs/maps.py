@@ -16,10 +16,10 @@ import numpy as np
 import yaml
 
 from robohealth_mj import schema
-from robohealth_mj.config import CONF_DIR
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.resources import conf_dir
 
-MAPS_DIR = CONF_DIR / "logmap"
+MAPS_DIR = conf_dir() / "logmap"
 
 # Unit -> (SI unit, factor to it). Amperes become N*m through the torque constant.
 UNITS: dict[str, tuple[str, float]] = {

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 
 
 @dataclass

@@ -8,7 +8,7 @@ from hydra.utils import instantiate
 from omegaconf import DictConfig, OmegaConf
 from torch import nn
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 
 
 def build_model(

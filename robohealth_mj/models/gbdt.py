@@ -65,7 +65,7 @@ class GradientBoostedTrees(nn.Module):
         del adjacency, window, backbone, max_pool  # trees see no graph and have no backbone
         self.num_joints, self.num_classes, self.in_features = num_joints, num_classes, in_features
         self.first_signal = first_signal
-        # added to the class logits; set by commissioning (runtime/operating_point.py)
+        # added to the class logits; set by commissioning (deploy/operating_point.py)
         self.register_buffer("class_offset", torch.zeros(num_classes), persistent=False)
         # Channel ablations: the signal channels the trees read (None: all of the schema's).
         names = schema.FEATURE_NAMES[first_signal:]

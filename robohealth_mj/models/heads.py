@@ -8,7 +8,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 
 COUPLING_FLOOR = 1e-2  # a set C's smallest entry: softplus never reaches zero
 

@@ -11,15 +11,8 @@ from __future__ import annotations
 
 import torch
 
-STATISTICS: tuple[str, ...] = (
-    "mean",
-    "std",
-    "min",
-    "max",
-    "last_minus_first",
-    "mean_abs_step",
-    "max_abs_step",
-)
+from robohealth_mj.schema import WINDOW_STATISTICS as STATISTICS
+
 NUM_STATISTICS = len(STATISTICS)
 
 

@@ -14,7 +14,7 @@ import torch
 from torch import nn
 
 from robohealth_mj import schema
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.models.adjacency import AdjacencyBuilder
 from robohealth_mj.models.backbone import GraphConvFactory, WindowBackbone
 from robohealth_mj.models.heads import (
@@ -102,7 +102,7 @@ class STGNN(nn.Module):
         self.placement = nn.Linear(num_joints, hidden, bias=False) if placement_embedding else None
         self.localise = None if anomaly_head else NodeLocalisationHead(hidden, num_joints, dropout)
         self.severity = SeverityHead(hidden, dropout) if severity_head else None
-        # added to the class logits; set by commissioning (runtime/operating_point.py)
+        # added to the class logits; set by commissioning (deploy/operating_point.py)
         self.register_buffer("class_offset", torch.zeros(num_classes), persistent=False)
 
     def node_embeddings(self, x: torch.Tensor) -> torch.Tensor:

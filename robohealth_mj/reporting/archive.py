@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from robohealth_mj.atomic import atomic_write_text
+from robohealth_mj.common.atomic import atomic_write_text
 
 SUMMARY = "train_summary.json"
 BLOCKS = "blocks.tsv"

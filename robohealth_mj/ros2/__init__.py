@@ -10,7 +10,7 @@ of ``rosbags`` ones, and reads them back with the bag reader's assembly. The bin
 
 from __future__ import annotations
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 
 
 def require_dds() -> None:

@@ -3,7 +3,7 @@
 Type names follow ``rmw_cyclonedds`` (``pkg::msg::dds_::Name_``); every struct is final (XCDR1,
 no member headers), as ROS 2 declares them. Field names equal the ROS ones, so the bag code's
 message factory and sample assembly work on these objects unchanged; :data:`TYPES` maps the
-``rosbags`` type names to them. ``tests/test_ros2.py`` checks the bytes against ``rosbags``.
+``rosbags`` type names to them. ``tests/ros2/test_ros2.py`` checks the bytes against ``rosbags``.
 """
 
 # No `from __future__ import annotations`: the binding resolves these annotations at class creation.

@@ -157,7 +157,7 @@ class FleetRuntime:
     def _open(self, path: Path, threads: int, incremental: bool, capacity: int) -> None:
         import onnxruntime as ort
 
-        from robohealth_mj.runtime.export import read_metadata
+        from robohealth_mj.runtime.metadata import read_metadata
 
         meta = read_metadata(path)
         if meta.get("node_names") != list(schema.NODE_NAMES):

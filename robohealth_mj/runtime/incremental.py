@@ -21,7 +21,9 @@ from typing import Any
 
 import numpy as np
 
-from robohealth_mj.models.statistics import NUM_STATISTICS
+from robohealth_mj.schema import WINDOW_STATISTICS
+
+NUM_STATISTICS = len(WINDOW_STATISTICS)
 
 
 def rows(slots: np.ndarray) -> slice | np.ndarray:

@@ -35,9 +35,9 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj import schema
-from robohealth_mj.arm_ratings import rated_torque_nm
 from robohealth_mj.runtime.runtime import HealthDiagnosis
 from robohealth_mj.schema import FaultLabel
+from robohealth_mj.sim.ratings import rated_torque_nm
 
 
 @dataclass

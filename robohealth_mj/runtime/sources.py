@@ -8,7 +8,7 @@ from collections.abc import Iterator
 
 from robohealth_mj.bags import is_bag
 from robohealth_mj.bags.reader import read_bag_samples
-from robohealth_mj.config import compose_config
+from robohealth_mj.common.config import compose_config
 from robohealth_mj.logs import is_log, log_samples
 from robohealth_mj.schema import FaultLabel, GraphSample, SchemaError, validate_sample
 
@@ -17,7 +17,7 @@ def sim_stream(
     overrides: list[str], duration_s: float
 ) -> Iterator[tuple[float, GraphSample, FaultLabel]]:
     """GraphSamples straight from the simulator (with its fault schedule)."""
-    from robohealth_mj.recorder import build_simulator, chunk_features, segment_info
+    from robohealth_mj.recording.recorder import build_simulator, chunk_features, segment_info
 
     sim = build_simulator(compose_config("record", ["session.progress=false", *overrides]))
     for chunk in sim.run(round(duration_s / sim.tick_s)):

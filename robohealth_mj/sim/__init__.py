@@ -1,5 +1,4 @@
-"""Physics simulation of the instrumented UR5e: model, control, sensors, curriculum."""
+"""Physics simulation of the instrumented UR5e: model, control, sensors, curriculum.
 
-from robohealth_mj.sim.dynamics import gravity_torques
-
-__all__ = ["gravity_torques"]
+Importing the package imports no MuJoCo: :mod:`robohealth_mj.sim.ratings` is read by the
+streaming runtime, which a deployment install runs without the simulator."""

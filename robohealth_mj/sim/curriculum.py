@@ -16,7 +16,7 @@ from functools import cache
 
 import numpy as np
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import N_JOINTS
 
 FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place")

@@ -7,7 +7,6 @@ is compiled with ``mujoco`` itself.
 
 from __future__ import annotations
 
-import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,11 +19,10 @@ with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     from dm_control import mjcf
 
+from robohealth_mj.common.resources import asset_dir
 from robohealth_mj.schema import JOINT_NAMES
 
-ASSET_DIR = Path(
-    os.environ.get("ROBOHEALTH_ASSETS", Path(__file__).resolve().parents[2] / "assets")
-)
+ASSET_DIR = asset_dir()
 SCENE_XML = ASSET_DIR / "ur5e" / "scene.xml"
 HOME_POSE = np.array([-np.pi / 2, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
 

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import N_JOINTS
 
 BROADBAND_HZ = (20.0, 400.0)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from robohealth_mj.errors import InputError
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.model import ArmIndex
 

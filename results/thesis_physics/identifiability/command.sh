@@ -3,6 +3,6 @@
 # joint's state on healthy ticks of four standard training sessions, and per-row corr(C, C0).
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
-$PY results/thesis_physics/identifiability/measure.py 'outputs/corpus/standard/train_0[0-3]*/graphs.jsonl' \
+$PY experiments/thesis_physics/identifiability/measure.py 'outputs/corpus/standard/train_0[0-3]*/graphs.jsonl' \
   outputs/thesis_physics/harness/full/C0/anomaly_residual/w32/seed42 \
   outputs/thesis_physics/harness/retrofit/C0/anomaly_residual/w32/seed42 > results/thesis_physics/identifiability/results.md

@@ -10,6 +10,6 @@ ROOT=outputs/severity_weight5 TRAIN_ARGS="seed=42 trainer.severity_loss_weight=5
 ROOT=outputs/severity_weight20 TRAIN_ARGS="trainer.severity_loss_weight=20" \
   bash results/thesis_physics/command.sh severity
 run=structural/full/C0/anomaly_residual+severity/w32
-$PY results/thesis_physics/severity/measure.py "$CORPUS/heldout_seed900" \
+$PY experiments/thesis_physics/severity/measure.py "$CORPUS/heldout_seed900" \
   outputs/thesis_physics/$run/seed4{2,3,4}/best.ckpt outputs/severity_weight5/$run/seed42/best.ckpt \
   outputs/severity_weight20/$run/seed4{2,3,4}/best.ckpt > results/thesis_physics/severity/results.md

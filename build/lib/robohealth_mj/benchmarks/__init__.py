@@ -1,0 +1,1 @@
+"""Throughput benchmarks behind ``python -m robohealth_mj.bench`` (measurements, not tests)."""

@@ -1,0 +1,102 @@
+"""``bench streams`` and ``bench soak``: the fleet runtime's load and soak reports."""
+
+from __future__ import annotations
+
+import argparse
+import os
+
+import numpy as np
+
+from robohealth_mj.benchmarks.soak import soak
+from robohealth_mj.benchmarks.streams import TICK_S, search, trial
+from robohealth_mj.runtime.evidence import EvidencePolicy
+from robohealth_mj.runtime.fleet import FleetRuntime, freeze_startup_heap
+
+
+def _frames(data: list[str]):
+    from robohealth_mj.data.arrays import expand_paths, load_recordings
+
+    return load_recordings(expand_paths(data)).x
+
+
+def _row(label: str, r: dict) -> str:
+    return (
+        f"| {label} | {r['streams']} | {r['p50_ms']:.1f} | {r['p99_ms']:.1f} | {r['max_ms']:.1f} "
+        f"| {r['late_ticks']} | {r['cpu_share']:.0%} |"
+    )
+
+
+def bench_fleet(args: argparse.Namespace) -> dict:
+    """Search the sustained stream count, then a paced run at ``--streams``, then the windowed
+    path at the same count; prints a markdown table."""
+    x = _frames(args.data)
+    cores = os.cpu_count() or 1
+    print(
+        f"{args.model}; {len(x)} recorded snapshots replayed from random offsets; {cores} cores, "
+        f"{args.shards} shard threads; timed: FleetRuntime.step (validate, buffer, infer, alarms)"
+    )
+    found = None
+    if not args.no_search:
+        print("search (unpaced, 100 ticks each after the windows fill):")
+        found, _ = search(args.model, x, 100, shards=args.shards)
+        print(f"sustained: {found} streams with per-tick p99 <= {TICK_S * 1e3:.0f} ms")
+    ticks = round(args.seconds / TICK_S)
+    paced = trial(args.model, x, args.streams, ticks, shards=args.shards, paced=True)
+    windowed = trial(args.model, x, args.streams, 40, incremental=False, shards=args.shards)
+    print(
+        "\n| path | streams | p50 ms | p99 ms | max ms | ticks over 50 ms | CPU (of all cores) |\n"
+        "|---|---|---|---|---|---|---|"
+    )
+    print(_row(f"incremental, paced 20 Hz for {args.seconds:g} s", paced))
+    print(_row("windowed (same runtime, whole window per tick), 40 ticks", windowed))
+    memory = memory_cost(args, x)
+    return {"sustained_streams": found, "paced": paced, "windowed": windowed, "memory": memory}
+
+
+def memory_cost(args: argparse.Namespace, x) -> dict:
+    """The step with and without evidence accumulation at ``--streams``, unpaced, alternated
+    (off, on, off, on) so that outside load falls on both alike; the ratio of their medians."""
+    policy = EvidencePolicy(horizon_s=args.memory_horizon)
+    runs: dict[str, list[dict]] = {"off": [], "on": []}
+    for _ in range(args.memory_rounds):
+        for key, evidence in (("off", None), ("on", policy)):
+            runs[key].append(trial(args.model, x, args.streams, 200, shards=args.shards,
+                                   evidence=evidence))  # fmt: skip
+    p50 = {k: float(np.median([r["p50_ms"] for r in v])) for k, v in runs.items()}
+    p99 = {k: float(np.median([r["p99_ms"] for r in v])) for k, v in runs.items()}
+    print(
+        f"\nmemory (evidence horizon {policy.horizon_s:g} s) at {args.streams} streams, unpaced, "
+        f"{args.memory_rounds} x 200 ticks each, alternated:\n"
+        f"| evidence | p50 ms | p99 ms |\n|---|---|---|\n"
+        f"| off | {p50['off']:.2f} | {p99['off']:.2f} |\n"
+        f"| on | {p50['on']:.2f} | {p99['on']:.2f} |\n"
+        f"step time with memory / without: p50 {p50['on'] / p50['off']:.3f}, "
+        f"p99 {p99['on'] / p99['off']:.3f}"
+    )
+    return {"p50_ms": p50, "p99_ms": p99, "ratio_p50": p50["on"] / p50["off"]}
+
+
+def bench_soak(args: argparse.Namespace) -> dict:
+    """A paced soak of ``--streams`` streams for ``--seconds`` under every bad-input kind."""
+    x = _frames(args.data)
+    fleet = FleetRuntime(
+        args.model, threads=1, shards=args.shards, capacity=args.streams,
+        max_streams=args.streams,
+    )  # fmt: skip
+    if fleet.engine is None:
+        raise SystemExit(f"bench soak: {fleet.problem}")
+    ticks = round(args.seconds / TICK_S)
+    freeze_startup_heap()
+    report = soak(fleet, x, args.streams, ticks, paced=True).summary()
+    print(f"soak: {args.streams} streams, {ticks} ticks paced at 20 Hz, {report['rows']} rows")
+    print("| bad-input kind | rows injected | not flagged with their reason |\n|---|---|---|")
+    for kind, n in report["injected"].items():
+        print(f"| {kind} | {n} | {report['missed'][kind]} |")
+    print(
+        f"healthy-stream rows without a decision after warm-up: {report['healthy_undecided']}\n"
+        f"step p50 {report['step_p50_ms']:.1f} ms, p99 {report['step_p99_ms']:.1f} ms, max "
+        f"{report['step_max_ms']:.1f} ms, {report['late_ticks']} ticks over 50 ms\n"
+        f"resident memory {report['rss_start_mb']:.0f} MB after the first quarter -> "
+        f"{report['rss_end_mb']:.0f} MB at the end ({report['rss_growth_mb']:+.1f} MB)"
+    )
+    return report

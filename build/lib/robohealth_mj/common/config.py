@@ -1,0 +1,47 @@
+"""Composing the project's Hydra configs outside a ``@hydra.main`` entry point (bench, tests)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from hydra import compose, initialize_config_dir
+from hydra.core.global_hydra import GlobalHydra
+from omegaconf import DictConfig, OmegaConf
+
+from robohealth_mj.common.resources import conf_dir
+
+
+def register_resolvers() -> None:
+    """``${placement:${graph}}`` in the configs (run directories): see ``placement_name``."""
+    from robohealth_mj.data.graphs import placement_name
+
+    OmegaConf.register_new_resolver("placement", placement_name, replace=True)
+
+
+def compose_config(name: str, overrides: Sequence[str] = ()) -> DictConfig:
+    """Compose ``conf/<name>.yaml`` with overrides, leaving Hydra's global state clean."""
+    register_resolvers()
+    GlobalHydra.instance().clear()
+    with initialize_config_dir(config_dir=str(conf_dir()), version_base="1.3"):
+        cfg = compose(config_name=name, overrides=list(overrides))
+    GlobalHydra.instance().clear()
+    return cfg
+
+
+def load_cli_config(
+    name: str, argv: Sequence[str], prog: str, include: Sequence[str] = ()
+) -> DictConfig:
+    """``conf/<name>.yaml`` with ``key=value`` overrides, for the small tools that are not Hydra
+    apps (``model=`` there names a file, not the training ``model`` config group). Each name in
+    ``include`` adds ``conf/<include>.yaml`` under that key (one block shared by several tools)."""
+    cfg = OmegaConf.load(conf_dir() / f"{name}.yaml")
+    for key in include:
+        cfg[key] = OmegaConf.load(conf_dir() / f"{key}.yaml")
+    keys = [a.split("=", 1)[0] for a in argv]
+    unknown = [k for k in keys if k.split(".")[0] not in cfg]
+    if unknown or any("=" not in a for a in argv):
+        raise SystemExit(
+            f"usage: python -m {prog} key=value ... (keys: {', '.join(cfg)}); "
+            f"not understood: {unknown or list(argv)}"
+        )
+    return OmegaConf.merge(cfg, OmegaConf.from_dotlist(list(argv)))

@@ -1,0 +1,1 @@
+"""Recordings on disk: the JSONL interchange format and its readers."""

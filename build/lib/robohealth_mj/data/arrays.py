@@ -1,0 +1,162 @@
+"""Recordings as arrays, with a binary cache so a corpus is parsed from JSONL only once.
+
+The cache (``<file>.cache.npz``) is keyed by the source's size, modification time and the schema
+version; any mismatch re-parses (and re-validates) the JSONL. Written atomically.
+"""
+
+from __future__ import annotations
+
+import glob
+import hashlib
+import io
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from robohealth_mj.common.atomic import atomic_write_bytes
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.data.read import is_bag, read_samples
+from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, SCHEMA_VERSION
+
+CACHE_SUFFIX = ".cache.npz"
+
+
+@dataclass
+class Recording:
+    """All samples of one or more files, in file order. ``run`` indexes ``run_ids``."""
+
+    x: np.ndarray  # [T, N, F] float32
+    run: np.ndarray  # [T] int32
+    run_ids: list[str]
+    sample_index: np.ndarray  # [T] int64
+    fault_class: np.ndarray  # [T] int64, index into FAULT_CLASSES
+    fault_joint: np.ndarray  # [T] int64, index into JOINT_NAMES, -1 when healthy
+    severity: np.ndarray  # [T] float32
+    active: np.ndarray  # [T] bool
+    payload_scale: np.ndarray  # [T] float32
+    sources: list[str]
+
+    def __len__(self) -> int:
+        return len(self.x)
+
+    def fingerprint(self) -> str:
+        """Identifies the data a model saw: run ids and their sample counts, plus a content hash."""
+        h = hashlib.sha256()
+        for rid, count in zip(
+            self.run_ids, np.bincount(self.run, minlength=len(self.run_ids)), strict=True
+        ):
+            h.update(f"{rid}:{count};".encode())
+        h.update(np.ascontiguousarray(self.x[:: max(1, len(self.x) // 997)]).tobytes())
+        return h.hexdigest()[:16]
+
+
+def _key(path: Path) -> str:
+    if path.is_dir():  # a bag: its storage files say whether it changed
+        st = max((f.stat() for f in path.iterdir() if f.is_file()), key=lambda s: s.st_mtime_ns)
+        return json.dumps(
+            {"size": st.st_size, "mtime_ns": st.st_mtime_ns, "schema": SCHEMA_VERSION}
+        )
+    st = path.stat()
+    return json.dumps({"size": st.st_size, "mtime_ns": st.st_mtime_ns, "schema": SCHEMA_VERSION})
+
+
+def _parse(path: Path) -> dict[str, np.ndarray]:
+    xs, runs, idx, cls, joint, sev, act, payload = [], [], [], [], [], [], [], []
+    run_ids: dict[str, int] = {}
+    for s in read_samples(path):
+        xs.append(s.x)
+        runs.append(run_ids.setdefault(s.recording_run_id, len(run_ids)))
+        idx.append(s.sample_index)
+        cls.append(FAULT_CLASSES.index(s.fault.fault_class))
+        joint.append(JOINT_NAMES.index(s.fault.joint) if s.fault.active else -1)
+        sev.append(s.fault.severity if s.fault.active else 0.0)
+        act.append(s.fault.active)
+        payload.append(float(s.segment["payload_scale"]))
+    if not xs:
+        raise InputError(f"{path}: no samples (an empty recording)")
+    return {
+        "x": np.stack(xs).astype(np.float32),
+        "run": np.array(runs, np.int32),
+        "run_ids": np.array(list(run_ids)),
+        "sample_index": np.array(idx, np.int64),
+        "fault_class": np.array(cls, np.int64),
+        "fault_joint": np.array(joint, np.int64),
+        "severity": np.array(sev, np.float32),
+        "active": np.array(act, bool),
+        "payload_scale": np.array(payload, np.float32),
+    }
+
+
+def _load_one(path: Path) -> dict[str, np.ndarray]:
+    cache = path.with_name(path.name + CACHE_SUFFIX)
+    key = _key(path)
+    if cache.is_file():
+        try:
+            with np.load(cache, allow_pickle=False) as data:
+                if str(data["key"]) == key:
+                    return {k: data[k] for k in data.files if k != "key"}
+        except (OSError, ValueError, KeyError):
+            pass  # unreadable cache: rebuild it below
+    arrays = _parse(path)
+    buffer = io.BytesIO()
+    np.savez(buffer, key=np.array(key), **arrays)
+    atomic_write_bytes(cache, buffer.getvalue())
+    return arrays
+
+
+def load_recordings(paths: list[Path | str]) -> Recording:
+    """Load (from cache when fresh) and concatenate recordings; run ids stay distinct."""
+    parts = [_load_one(Path(p)) for p in paths]
+    run_ids: list[str] = []
+    runs = []
+    for part in parts:
+        names = [str(r) for r in part["run_ids"]]
+        duplicate = set(names) & set(run_ids)
+        if duplicate:
+            raise InputError(f"recording_run_id {sorted(duplicate)} appears in more than one file")
+        runs.append(part["run"] + len(run_ids))
+        run_ids += names
+    cat = {
+        k: np.concatenate([p[k] for p in parts])
+        for k in (
+            "x",
+            "sample_index",
+            "fault_class",
+            "fault_joint",
+            "severity",
+            "active",
+            "payload_scale",
+        )
+    }
+    return Recording(
+        run=np.concatenate(runs), run_ids=run_ids, sources=[str(p) for p in paths], **cat
+    )
+
+
+def resolve_recordings(paths: list[str] | str) -> list[Path]:
+    """Files, session directories (their ``graphs.jsonl``) or rosbag2 directories; a corpus
+    dir's ``train_*`` too."""
+    out = []
+    for raw in [paths] if isinstance(paths, str) else paths:
+        p = Path(raw)
+        if p.is_dir() and (p / "graphs.jsonl").is_file():
+            out.append(p / "graphs.jsonl")
+        elif is_bag(p) or p.is_file():
+            out.append(p)
+        else:
+            raise FileNotFoundError(f"no recording at {raw}")
+    return out
+
+
+def expand_paths(patterns: list[str] | str) -> list[Path]:
+    """Paths, session dirs and glob patterns -> recording files (sorted, each once)."""
+    patterns = [patterns] if isinstance(patterns, str) else list(patterns)
+    found: list[str] = []
+    for pattern in patterns:
+        matches = sorted(glob.glob(pattern)) if any(c in pattern for c in "*?[") else [pattern]
+        if not matches:
+            raise FileNotFoundError(f"no recordings match {pattern!r}")
+        found += matches
+    return list(dict.fromkeys(resolve_recordings(found)))

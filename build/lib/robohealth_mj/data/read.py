@@ -1,0 +1,52 @@
+"""Samples from a recording of any kind: the one place that dispatches on file kind.
+
+It sits above every reader (GraphSample JSONL in :mod:`robohealth_mj.data.jsonl`, rosbag2 in
+:mod:`robohealth_mj.bags.reader`, controller logs in :mod:`robohealth_mj.logs`), so none imports
+another; the bag reader (and ``rosbags``) is imported only when a bag is read, a log's column map
+is the shipped one whose columns it has.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+
+from robohealth_mj.bags import is_bag
+from robohealth_mj.data.jsonl import read_jsonl_samples
+from robohealth_mj.logs import is_log, log_samples
+from robohealth_mj.schema import GraphSample
+
+__all__ = ["is_bag", "is_log", "read_samples", "recording_sensing"]
+
+
+def recording_sensing(path: Path | str) -> str:
+    """The sensing profile a recording carries: a controller log only the joint channels
+    (``stock``), as does a bag without the sensor topics; a recording its manifest's
+    ``sensing`` (the ingested logs' is ``stock``); a simulated one every channel (``full``)."""
+    path = Path(path)
+    if is_log(path):
+        return "stock"
+    if is_bag(path):
+        from robohealth_mj.bags.reader import bag_sensing
+
+        return bag_sensing(path)
+    manifest = (path if path.is_dir() else path.parent) / "manifest.json"
+    if manifest.is_file():
+        try:
+            return str(json.loads(manifest.read_text()).get("sensing", "full"))
+        except (ValueError, AttributeError):
+            return "full"
+    return "full"
+
+
+def read_samples(path: Path | str) -> Iterator[GraphSample]:
+    """Validated samples of a GraphSample JSONL file, a rosbag2 directory or a controller log
+    (``.csv``, ``.parquet``)."""
+    if is_log(path):
+        return log_samples(path)
+    if is_bag(path):
+        from robohealth_mj.bags.reader import read_bag_samples
+
+        return read_bag_samples(Path(path))
+    return read_jsonl_samples(path)

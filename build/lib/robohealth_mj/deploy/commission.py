@@ -1,0 +1,204 @@
+"""Commissioning a model on a new arm: minutes of its healthy running, no labels.
+
+What is arm-specific is refitted and the rest kept: the healthy baseline of the residual
+channels (its constant term is the normalisation's offset; see :mod:`robohealth_mj.data.baseline`)
+is fitted on the new arm and on the model's own training arms (their healthy ticks), and the
+difference rides with the graph into the checkpoint and the exported model's input stage. The
+report says how many healthy minutes the baseline needed to settle. A harness model's coupling
+``C`` is refitted to where the arm's sensors sit (placement self-calibration), and last the
+healthy operating point is matched (:mod:`robohealth_mj.deploy.operating_point`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robohealth_mj import schema
+from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.data import baseline
+from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
+from robohealth_mj.data.graphs import GraphSpec, harness_graph
+from robohealth_mj.deploy.export import export_checkpoint, file_fingerprint
+from robohealth_mj.deploy.operating_point import Reading, check_recipe, match_operating_point
+from robohealth_mj.deploy.recouple import recouple
+from robohealth_mj.learn.checkpoint import (
+    check_recordings,
+    graph_from_checkpoint,
+    load_checkpoint,
+    model_from_checkpoint,
+    save_checkpoint,
+)
+from robohealth_mj.learn.trainer import CHECKPOINT
+
+PLACEMENT = "placement.json"  # the placement self-calibration found, [6, M]
+MINUTES = (0.5, 1.0, 2.0, 3.0, 5.0, 7.5, 10.0, 15.0, 20.0)
+SETTLED = 0.1  # a baseline has settled when it moves the residuals within 10 % of the final fit
+
+
+def _healthy(ckpt: dict, paths: list[str] | str, what: str) -> Recording:
+    files = expand_paths(paths)
+    check_recordings(ckpt, files)
+    rec = load_recordings(files)
+    if what == "healthy" and rec.active.any():
+        raise InputError(
+            f"{files[0]}: {int(rec.active.sum())} of the {what} ticks carry an active fault; "
+            "commission on healthy running only"
+        )
+    return rec
+
+
+def settling(x: np.ndarray, tick_hz: float, final: np.ndarray, delta: np.ndarray) -> list[dict]:
+    """For growing prefixes of the healthy data: how far the baseline fitted on that prefix moves
+    the residuals from where the final fit moves them, relative to the final shift's size."""
+    b = baseline.basis(x.astype(np.float64))
+    size = float(np.sqrt(np.mean(np.square(np.einsum("tjb,jcb->tjc", b, delta))))) or 1.0
+    rows = []
+    for minutes in MINUTES:
+        n = int(minutes * 60 * tick_hz)
+        if n > len(x):
+            break
+        gap = np.einsum("tjb,jcb->tjc", b, baseline.fit(x[:n]) - final)
+        rows.append({"minutes": minutes, "relative_error": float(np.sqrt(np.mean(gap**2))) / size})
+    return rows
+
+
+def reads_residuals(graph: GraphSpec) -> bool:
+    """Whether the model reads a residual channel on a joint: only then does the residual
+    baseline, and how many minutes it took to settle, mean anything for it."""
+    if graph.channel_mask is None:
+        return True
+    columns = [schema.feature_index(name) for name in baseline.RESIDUALS]
+    return bool(graph.channel_mask[: schema.N_JOINTS, columns].any())
+
+
+def arm_placement(graph: GraphSpec, placement: dict | None) -> np.ndarray:
+    """Where this arm's harness sensors sit: ``placement`` (``coupling_seed`` and
+    ``coupling_sensors``, ``coupling_file`` or ``coupling``, as ``graph=harness`` takes them),
+    or the checkpoint's own. The simulation mixes the arm's data by it; the model is not told."""
+    given = {k: v for k, v in (placement or {}).items() if v is not None}
+    if not given:
+        return graph.coupling
+    m = graph.coupling.shape[1]
+    c = harness_graph(**{"coupling_sensors": m, **given}).coupling
+    if c.shape != graph.coupling.shape:
+        raise InputError(
+            f"placement: the model reads {m} sensors, the placement places {c.shape[1]}"
+        )
+    return c
+
+
+def commission(
+    ckpt_path: Path | str,
+    healthy: list[str] | str,
+    out_dir: Path | str,
+    reference: list[str] | str | None = None,
+    export: bool = True,
+    tick_hz: float = 20.0,
+    placement: dict | None = None,
+    placement_fit: str = "motion",
+    placement_prune: float | None = None,
+    operating_point: str = "per_class",
+) -> dict[str, Any]:
+    """Write ``out_dir/best.ckpt`` (and ``model.onnx`` for a network) commissioned on
+    ``healthy``; the commissioning record (also in the checkpoint). A harness model with a
+    coupling head also has its ``C`` refitted to the arm's ``placement``
+    (:mod:`robohealth_mj.deploy.recouple`)."""
+    check_recipe(operating_point)  # before minutes of work, not after
+    ckpt = load_checkpoint(ckpt_path)
+    arm = _healthy(ckpt, healthy, "healthy")
+    reference = reference or ckpt["config"].get("data", {}).get("train")
+    if not reference:
+        raise InputError(f"{ckpt_path}: no training data named in it: pass reference=DATA")
+    ref = _healthy(ckpt, reference, "reference")
+    ref_x = ref.x[~ref.active]
+    w_ref, w_arm = baseline.fit(ref_x), baseline.fit(arm.x)
+    delta = (w_arm - w_ref).astype(np.float32)
+    trained = graph_from_checkpoint(ckpt)
+    reads = reads_residuals(trained)
+    rows = settling(arm.x, tick_hz, w_arm, delta) if reads else []
+    settled = next(
+        (r["minutes"] for k, r in enumerate(rows)
+         if all(later["relative_error"] <= SETTLED for later in rows[k:])),
+        None,
+    )  # fmt: skip
+    record = {
+        "healthy": [str(p) for p in expand_paths(healthy)],
+        "healthy_fingerprint": arm.fingerprint(),
+        "healthy_minutes": round(len(arm) / tick_hz / 60.0, 2),
+        "reference_fingerprint": ref.fingerprint(),
+        "settling": rows,
+        "settled_minutes": settled,
+        "from_checkpoint": str(ckpt_path),
+    }
+    if not reads:
+        record["settling_skipped"] = (
+            f"the sensing profile '{trained.sensing}' reads no residual channel "
+            f"({', '.join(baseline.RESIDUALS)})"
+        )
+    graph = replace(trained, baseline_shift=delta)
+    out_dir = Path(out_dir)
+    model = model_from_checkpoint(ckpt)
+    mean, std = ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()
+    if graph.coupling is not None and getattr(model, "anomaly", None) is not None:
+        graph = replace(graph, coupling=arm_placement(graph, placement))
+        drawn = int((ckpt["config"].get("trainer") or {}).get("placements") or 0)
+        mean, std, record["placement"] = recouple(
+            model,
+            graph,
+            arm,
+            ref,
+            mean,
+            std,
+            int(ckpt["window"]),
+            placement_fit,
+            drawn > 0,
+            prune=placement_prune,
+        )
+        # the placement found, as graph.coupling_file reads it: a model can be trained on it
+        record["placement"]["file"] = str(out_dir / PLACEMENT)
+        atomic_write_json(out_dir / PLACEMENT, record["placement"]["coupling"])
+    elif placement:
+        raise InputError(
+            f"{ckpt_path}: placement= is for harness models with a coupling head; "
+            "this model has no placement to calibrate"
+        )
+    offset, record["operating_point"] = match_operating_point(
+        model,
+        int(ckpt["window"]),
+        Reading(ref, trained, ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()),
+        list((ckpt.get("split_runs") or {}).get("val", [])),
+        Reading(arm, graph, mean, std),
+        operating_point,
+    )
+    save_checkpoint(
+        out_dir / CHECKPOINT,
+        model,
+        model_cfg=ckpt["model_cfg"],
+        variant=ckpt["variant"],
+        graph=graph,
+        window=int(ckpt["window"]),
+        mean=mean,
+        std=std,
+        config=ckpt["config"],
+        code_version=ckpt["code_version"],
+        data_fingerprint=ckpt["data_fingerprint"],
+        best_epoch=int(ckpt["best_epoch"]),
+        extra={
+            "gamma": ckpt.get("gamma"),
+            "split_runs": ckpt.get("split_runs"),
+            "commissioning": record,
+            "class_offset": offset.tolist(),
+        },
+    )
+    record["checkpoint"] = str(out_dir / CHECKPOINT)
+    network = not callable(getattr(model, "fit", None))
+    if export and network:
+        result = export_checkpoint(out_dir / CHECKPOINT, out_dir / "model.onnx", data=healthy)
+        record["onnx"] = result["path"]
+        record["onnx_fingerprint"] = file_fingerprint(result["path"])
+    return record

@@ -1,0 +1,36 @@
+"""``python -m robohealth_mj.evaluate ckpt=… data=…``: score a checkpoint on whole recordings.
+
+``data`` is a file, a session directory or a glob (quote it); ``out`` is the output prefix
+(default: ``eval_<data name>`` next to the checkpoint). Writes JSON and CSV atomically.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import hydra
+from omegaconf import DictConfig
+
+from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.common.resources import HYDRA_CONF
+from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
+
+
+@hydra.main(config_path=HYDRA_CONF, config_name="evaluate", version_base="1.3")
+def main(cfg: DictConfig) -> None:
+    if not cfg.ckpt or not cfg.data:
+        raise SystemExit("usage: python -m robohealth_mj.evaluate ckpt=PATH data=PATH [out=PREFIX]")
+    with one_line_errors("evaluate"):
+        result = evaluate_checkpoint(cfg.ckpt, cfg.data, cfg.device)
+    prefix = cfg.out or Path(cfg.ckpt).parent / f"eval_{Path(str(cfg.data)).stem}"
+    json_path, _ = write_evaluation(result, prefix)
+    m = result["metrics"]
+    print(
+        f"{result['variant']} on {len(result['data'])} file(s): accuracy {m['accuracy']:.3f}  "
+        f"fault-present {m['fault_present_accuracy']:.3f}  macro-F1 {m['macro_f1']:.3f}  "
+        f"localisation {m['localisation_accuracy']:.3f} -> {json_path}"
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1 @@
+"""Training and evaluation: tensors on the device, losses, metrics, checkpoints."""

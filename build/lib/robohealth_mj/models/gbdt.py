@@ -1,0 +1,170 @@
+"""The ``gbdt`` baseline: gradient-boosted trees (LightGBM) on the window statistics of every node.
+
+It is the bar the graph models are measured against, so it goes through the same commands,
+splits, checkpoints and metrics: it is an ``nn.Module`` whose boosters live in two byte buffers
+(their text dumps), so ``state_dict``, ``torch.load(weights_only=True)`` and evaluation work as
+for the networks. It is fitted by :meth:`fit`, not by gradients.
+
+Two boosters: the fault class over all windows, and the faulted joint over faulted windows.
+Features: :func:`window_statistics` of every node, flattened (N * S * 7 columns).
+
+Shapes: ``x [B, W, N, F]`` -> ``class_logits [B, C]``, ``joint_logits [B, J]`` (raw scores).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+from robohealth_mj import schema
+from robohealth_mj.models.statistics import window_statistics
+
+
+def _booster_bytes(booster: Any | None) -> torch.Tensor:
+    if booster is None:
+        return torch.zeros(0, dtype=torch.uint8)
+    text = booster.model_to_string().encode()
+    return torch.frombuffer(bytearray(text), dtype=torch.uint8).clone()
+
+
+def _booster_from(buffer: torch.Tensor):
+    import lightgbm as lgb
+
+    if buffer.numel() == 0:
+        return None
+    return lgb.Booster(model_str=bytes(buffer.cpu().numpy()).decode())
+
+
+class GradientBoostedTrees(nn.Module):
+    """LightGBM multiclass boosters on flattened per-node window statistics."""
+
+    def __init__(
+        self,
+        adjacency: torch.Tensor,
+        num_joints: int,
+        in_features: int,
+        window: int,
+        num_classes: int = 7,
+        rounds: int = 300,
+        early_stopping_rounds: int = 30,
+        learning_rate: float = 0.1,
+        num_leaves: int = 63,
+        min_child_samples: int = 20,
+        feature_fraction: float = 0.5,
+        max_bin: int = 63,
+        metric: str = "multi_error",
+        first_signal: int = 2,
+        channels: list[str] | None = None,
+        backbone: Any = None,
+        max_pool: Any = None,
+    ) -> None:
+        super().__init__()
+        del adjacency, window, backbone, max_pool  # trees see no graph and have no backbone
+        self.num_joints, self.num_classes, self.in_features = num_joints, num_classes, in_features
+        self.first_signal = first_signal
+        # added to the class logits; set by commissioning (deploy/operating_point.py)
+        self.register_buffer("class_offset", torch.zeros(num_classes), persistent=False)
+        # Channel ablations: the signal channels the trees read (None: all of the schema's).
+        names = schema.FEATURE_NAMES[first_signal:]
+        unknown = sorted(set(channels or ()) - set(names))
+        if unknown:
+            raise ValueError(f"model.channels: unknown {unknown}; known: {list(names)}")
+        keep = [first_signal + names.index(c) for c in channels] if channels else None
+        self.register_buffer("channel_index", torch.tensor(keep if keep else [], dtype=torch.long))
+        self.params = {
+            "learning_rate": learning_rate,
+            "num_leaves": num_leaves,
+            "min_child_samples": min_child_samples,
+            "feature_fraction": feature_fraction,
+            "max_bin": max_bin,
+            "metric": metric,
+            "verbosity": -1,
+            "deterministic": True,
+            "force_col_wise": True,
+        }
+        self.rounds, self.early_stopping_rounds = int(rounds), int(early_stopping_rounds)
+        self.register_buffer("class_booster", _booster_bytes(None))
+        self.register_buffer("joint_booster", _booster_bytes(None))
+        self._boosters: dict[str, Any] = {}
+
+    def features(self, x: torch.Tensor) -> np.ndarray:
+        """``[B, W, N, F]`` -> ``[B, N * S * 7]`` float32."""
+        if self.channel_index.numel():
+            x = torch.cat([x[..., : self.first_signal], x[..., self.channel_index]], dim=-1)
+        with torch.no_grad():
+            stats = window_statistics(x.float(), self.first_signal)
+        return stats.flatten(1).cpu().numpy()
+
+    def fit(
+        self,
+        train: tuple[np.ndarray, np.ndarray, np.ndarray],
+        val: tuple[np.ndarray, np.ndarray, np.ndarray],
+        seed: int,
+        threads: int | None = None,
+    ) -> dict[str, Any]:
+        """Fit both boosters. ``train``/``val``: (features ``[K, D]``, class ``[K]``, joint
+        ``[K]`` with -1 on healthy windows). Early stopping on the validation split's ``metric``
+        (error rate by default: the log-loss turns up long before accuracy stops improving)."""
+        import lightgbm as lgb
+
+        params = {**self.params, "seed": int(seed), "num_threads": int(threads or 0)}
+        record: dict[str, Any] = {}
+        for name, num, pick in (
+            ("class", self.num_classes, lambda c, j: np.ones(len(c), bool)),
+            ("joint", self.num_joints, lambda c, j: j >= 0),
+        ):
+            target = 1 if name == "class" else 2
+            tr, va = pick(train[1], train[2]), pick(val[1], val[2])
+            dtrain = lgb.Dataset(train[0][tr], train[target][tr], free_raw_data=True)
+            dval = lgb.Dataset(val[0][va], val[target][va], reference=dtrain)
+            evals: dict = {}
+            booster = lgb.train(
+                {**params, "objective": "multiclass", "num_class": num},
+                dtrain,
+                num_boost_round=self.rounds,
+                valid_sets=[dval],
+                valid_names=["val"],
+                callbacks=[
+                    lgb.early_stopping(self.early_stopping_rounds, verbose=False),
+                    lgb.record_evaluation(evals),
+                ],
+            )
+            self._boosters[name] = booster
+            setattr(self, f"{name}_booster", _booster_bytes(booster))
+            record[name] = {
+                "best_iteration": int(booster.best_iteration),
+                f"val_{self.params['metric']}": [
+                    float(v) for v in evals["val"][self.params["metric"]]
+                ],
+            }
+        return record
+
+    def _booster(self, name: str):
+        if name not in self._boosters:
+            booster = _booster_from(getattr(self, f"{name}_booster"))
+            if booster is None:
+                raise RuntimeError("the gbdt model has not been fitted")
+            self._boosters[name] = booster
+        return self._boosters[name]
+
+    def _load_from_state_dict(self, state_dict, prefix, local_metadata, strict, missing, *rest):
+        for name in ("class_booster", "joint_booster"):
+            key = prefix + name
+            if key in state_dict:
+                setattr(self, name, state_dict[key].detach().clone().to(torch.uint8))
+            elif strict:
+                missing.append(key)
+        self._boosters = {}
+
+    def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:
+        feats = self.features(x)
+        out = {}
+        for name, key in (("class", "class_logits"), ("joint", "joint_logits")):
+            booster = self._booster(name)
+            raw = booster.predict(feats, raw_score=True)
+            out[key] = torch.from_numpy(np.asarray(raw, np.float32)).to(x.device)
+        out["class_logits"] = out["class_logits"] + self.class_offset
+        return out

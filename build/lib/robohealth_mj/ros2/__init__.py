@@ -1,0 +1,23 @@
+"""A live ROS 2 participant over DDS (Eclipse Cyclone DDS's Python binding), without ROS 2.
+
+ROS 2 talks DDS on the wire: a topic ``/a/b`` is the DDS topic ``rt/a/b``, a message type
+``pkg/msg/Name`` the DDS type ``pkg::msg::dds_::Name_``, and the payload the same XCDR1 bytes that
+``rosbags`` writes into bags. So this package builds the project's messages with the same
+:class:`~robohealth_mj.bags.messages.MessageFactory` as the bag writer, over IDL classes instead
+of ``rosbags`` ones, and reads them back with the bag reader's assembly. The binding is optional
+(``pip install .[ros2]``); :func:`require_dds` says so in one line where it is missing.
+"""
+
+from __future__ import annotations
+
+from robohealth_mj.common.errors import InputError
+
+
+def require_dds() -> None:
+    """Import the DDS binding or fail with one line saying how to install it."""
+    try:
+        import cyclonedds  # noqa: F401
+    except ImportError:
+        raise InputError(
+            "the ROS 2 bridge needs the cyclonedds package: pip install '.[ros2]'"
+        ) from None

@@ -1,0 +1,233 @@
+"""One arm's GraphSamples from its topics as messages arrive, in any order across topics.
+
+Stamped topics (joint states, tracking error, each IMU, the ground truth) are keyed by their
+header stamp, a vibration array by the stamp its layout carries (``stamp_ns=``); an array without
+one (another publisher's) queues in arrival order and the oldest goes with the oldest stamp. A stamp
+is emitted once every topic has its message, in stamp order.
+
+What goes wrong on a live bus is returned for that arm, never raised. Problems (bad input): a
+message that does not assemble (wrong array length, unknown joint order, NaN), a second,
+different message at one stamp, a stamp older than every recent one (the clock went back), and a
+tick whose messages stopped coming while newer ones completed. That last judgement is made only
+at a poll boundary (:meth:`ArmAssembler.settle`, once every reader has been taken): a monitor
+takes its topics one after another, so mid-poll the stamped topics of a long backlog are in while
+the arrays of the same ticks are still in their readers. Not problems, counted apart: a repeated
+identical message (``duplicates``: a re-delivery or re-publish) and a message for a tick already
+reported missing (``late``).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from robohealth_mj.bags.messages import (
+    array_stamp_ns,
+    sample_from_aggregated,
+    sample_from_messages,
+)
+from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.schema import FEATURE_NAMES, JOINT_NAMES, NODE_NAMES, FaultLabel, GraphSample
+
+UNKNOWN_TRUTH = FaultLabel("none", None, 0.0, False)
+
+
+@dataclass
+class Assembled:
+    samples: list[GraphSample] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)
+    duplicates: int = 0  # repeated identical messages, dropped
+    late: int = 0  # messages for ticks already reported missing, dropped
+
+
+def _stamp_ns(msg: Any) -> int | None:
+    header = getattr(msg, "header", None)
+    return None if header is None else int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
+
+
+class _Problem(Exception):
+    pass
+
+
+class ArmAssembler:
+    """Assembles one arm's samples; ``topics`` are that arm's (namespaced) topic names."""
+
+    def __init__(
+        self,
+        arm: str,
+        topics: BagTopics,
+        require_truth: bool = True,
+        late_ticks: int = 10,
+        aggregated: str | None = None,
+        sensors: bool = True,
+    ) -> None:
+        self.arm, self.topics, self.aggregated = arm, topics, aggregated
+        self.require_truth, self.late_ticks, self.sensors = require_truth, late_ticks, sensors
+        if aggregated:  # one array per tick carries the whole snapshot
+            self.vibration, self.imu, self.stamped = [], [], [aggregated]
+        elif not sensors:  # a stock arm: its joint state and tracking error only
+            self.vibration, self.imu = [], []
+            self.stamped = [topics.joint_states, topics.joint_errors]
+        else:
+            self.vibration = [topics.vibration.format(joint=j) for j in JOINT_NAMES]
+            self.imu = [topics.imu.format(joint=j) for j in JOINT_NAMES]
+            self.stamped = [topics.joint_states, topics.joint_errors, *self.imu]
+        if require_truth:
+            self.stamped.append(topics.fault_state)
+        self.pending: dict[int, dict[str, Any]] = {}
+        self.queues: dict[str, deque] = {t: deque() for t in self.vibration}
+        self.last_emitted: int | None = None
+        # the messages of the last settled (emitted or missed) ticks, to tell a duplicate or a
+        # late message from a stamp that went backwards
+        self.settled: dict[int, dict[str, Any]] = {}
+        self.settled_kept = max(4 * late_ticks, 32)
+        self.count = 0
+
+    def topic_names(self) -> list[str]:
+        return [*self.stamped, *self.vibration]
+
+    def add(self, topic: str, msg: Any) -> Assembled:
+        """Take one message; return the samples it completed and any problems."""
+        out = Assembled()
+        if topic in self.queues and array_stamp_ns(msg) is None:
+            self.queues[topic].append(msg)
+        else:
+            headerless = topic in self.queues or topic == self.aggregated
+            stamp = array_stamp_ns(msg) if headerless else _stamp_ns(msg)
+            if stamp is None:
+                out.problems.append(f"topic '{topic}': message without a header stamp")
+                return out
+            if self.last_emitted is not None and stamp <= self.last_emitted:
+                self._settled_message(topic, stamp, msg, out)
+                return out
+            slot = self.pending.setdefault(stamp, {})
+            if topic in slot:
+                self._repeated(topic, stamp, slot[topic], msg, out)
+                return out
+            slot[topic] = msg
+        self._drain(out, drop_late=False)
+        return out
+
+    def settle(self) -> Assembled:
+        """At a poll boundary: report the ticks that stay incomplete while ``late_ticks`` newer
+        ones have every stamped topic, and emit what waited behind them."""
+        out = Assembled()
+        self._drain(out, drop_late=True)
+        return out
+
+    def _repeated(self, topic: str, stamp: int, first: Any, msg: Any, out: Assembled) -> None:
+        if msg == first:
+            out.duplicates += 1
+        else:
+            out.problems.append(
+                f"topic '{topic}': a second, different message at stamp {stamp / 1e9:.6f} s"
+            )
+
+    def _settled_message(self, topic: str, stamp: int, msg: Any, out: Assembled) -> None:
+        """A message at or before the last emitted stamp: a duplicate of one already used, a
+        late one for a tick reported missing, or a stamp from before the recent ticks."""
+        slot = self.settled.get(stamp)
+        if slot is None:
+            out.problems.append(
+                f"topic '{topic}': stamp {stamp / 1e9:.6f} s is not after the last sample "
+                f"({self.last_emitted / 1e9:.6f} s): stamps went backwards"
+            )
+        elif topic in slot:
+            self._repeated(topic, stamp, slot[topic], msg, out)
+        else:
+            out.late += 1
+
+    def _settle(self, stamp: int, slot: dict[str, Any]) -> None:
+        del self.pending[stamp]
+        self.last_emitted = stamp
+        self.settled[stamp] = slot
+        while len(self.settled) > self.settled_kept:
+            del self.settled[min(self.settled)]
+
+    def _stamped_in(self, slot: dict[str, Any]) -> bool:
+        return all(t in slot for t in self.stamped)
+
+    def _complete(self, slot: dict[str, Any]) -> bool:
+        return self._stamped_in(slot) and all(t in slot or self.queues[t] for t in self.vibration)
+
+    def _drain(self, out: Assembled, drop_late: bool) -> None:
+        while self.pending:
+            oldest = min(self.pending)
+            slot = self.pending[oldest]
+            if self._complete(slot):
+                vibs = [slot[t] if t in slot else self.queues[t].popleft() for t in self.vibration]
+                self._settle(oldest, slot)
+                try:
+                    out.samples.append(self._sample(oldest, slot, vibs))
+                except _Problem as exc:
+                    out.problems.append(str(exc))
+                continue
+            if not drop_late:
+                return
+            newer_complete = sum(
+                1 for s, sl in self.pending.items() if s > oldest and self._stamped_in(sl)
+            )
+            if newer_complete < self.late_ticks:
+                return
+            missing = [t for t in self.stamped if t not in slot] or [
+                t for t in self.vibration if t not in slot and not self.queues[t]
+            ]
+            self._settle(oldest, slot)
+            out.problems.append(
+                f"topic '{missing[0]}' at stamp {oldest / 1e9:.6f} s: message missing "
+                f"({len(missing)} topics)"
+            )
+
+    def _sample(self, stamp: int, slot: dict[str, Any], vibs: list[Any]) -> GraphSample:
+        at = f"at stamp {stamp / 1e9:.6f} s"
+
+        def where(key, message: str) -> _Problem:
+            if key == "aggregated":
+                topic = self.aggregated
+            else:
+                topic = (
+                    getattr(self.topics, key) if isinstance(key, str) else self.vibration[key[1]]
+                )
+            return _Problem(f"topic '{topic}' {at}: {message}")
+
+        truth = slot.get(self.topics.fault_state) if self.require_truth else None
+        truth = truth if truth is not None else _NoTruth(self.arm, self.count)
+        try:
+            if self.aggregated:
+                sample = sample_from_aggregated(stamp / 1e9, slot[self.aggregated], truth, where)
+            else:
+                sample = sample_from_messages(
+                    stamp / 1e9,
+                    slot[self.topics.joint_states],
+                    slot[self.topics.joint_errors],
+                    [slot[t] for t in self.imu] if self.sensors else None,
+                    vibs if self.sensors else None,
+                    truth,
+                    where,
+                )
+        except (AttributeError, TypeError, ValueError) as exc:
+            raise _Problem(f"{at}: malformed message ({exc})") from None
+        bad = np.argwhere(~np.isfinite(sample.x))
+        if bad.size:
+            node, feat = bad[0]
+            raise _Problem(f"{at}: NaN or Inf in x[{NODE_NAMES[node]}].{FEATURE_NAMES[feat]}")
+        self.count += 1
+        return sample
+
+
+class _NoTruth:
+    """Stands in for ``/fault_state`` on a robot that publishes no ground truth: the sample is
+    numbered by arrival and labelled healthy-unknown."""
+
+    def __init__(self, arm: str, index: int) -> None:
+        from types import SimpleNamespace
+
+        values = [
+            SimpleNamespace(key=k, value=v)
+            for k, v in (("class", "none"), ("joint", ""), ("severity", "0"), ("active", "false"),
+                         ("sample_index", str(index)), ("segment", "{}"))
+        ]  # fmt: skip
+        self.status = [SimpleNamespace(hardware_id=arm, values=values)]

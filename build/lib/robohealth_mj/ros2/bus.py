@@ -1,0 +1,129 @@
+"""One DDS participant following ROS 2's conventions: names, QoS profiles, domain and interface.
+
+- Topic names (``ros2/design``, "Topic and Service name mapping to DDS"): a ROS topic ``/a/b`` is
+  the DDS topic ``rt/a/b``.
+- QoS (``rmw/qos_profiles.h``): the default profile (reliable, volatile, keep last 10) for what we
+  publish; the sensor-data profile (best effort, volatile, keep last 5) is what we subscribe with
+  by default, because a best-effort reader matches both reliable and best-effort writers.
+- Fast DDS 3 peers (recent ROS 2's default middleware) advertise type information that Cyclone
+  rejects unless told to ignore it for their vendor id (``Compatibility/IgnoreTypeInformation``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+from xml.sax.saxutils import escape
+
+EPROSIMA_VENDOR_ID = "1.15"  # Fast DDS's RTPS vendor id, as Cyclone writes it
+
+
+@dataclass(frozen=True)
+class BusConfig:
+    domain_id: int = 0  # ROS_DOMAIN_ID
+    interface: str | None = None  # an address or interface name; None: Cyclone's choice
+    ignore_type_information: bool = False  # for Fast DDS 3 peers
+    reliable_subscriptions: bool = False  # default: best effort (matches every writer)
+    depth: int = 10  # history depth of readers and writers
+
+    def xml(self) -> str:
+        """Cyclone DDS's configuration for this participant's domain."""
+        general = discovery = ""
+        if self.interface:
+            attr = "address" if self.interface[0].isdigit() else "name"
+            loopback = self.interface.startswith("127.") or self.interface == "lo"
+            general = (
+                f'<General><Interfaces><NetworkInterface {attr}="{escape(self.interface)}"/>'
+                f"</Interfaces>{'<AllowMulticast>false</AllowMulticast>' if loopback else ''}"
+                "</General>"
+            )
+            if loopback:  # no multicast on loopback: unicast discovery of local participants
+                discovery = (
+                    "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
+                    "<MaxAutoParticipantIndex>200</MaxAutoParticipantIndex>"
+                    '<Peers><Peer address="127.0.0.1"/></Peers></Discovery>'
+                )
+        compat = (
+            f"<Compatibility><IgnoreTypeInformation>{EPROSIMA_VENDOR_ID}"
+            "</IgnoreTypeInformation></Compatibility>"
+            if self.ignore_type_information
+            else ""
+        )
+        return f'<CycloneDDS><Domain id="any">{general}{discovery}{compat}</Domain></CycloneDDS>'
+
+
+def dds_topic(ros_name: str) -> str:
+    """``/a/b`` -> ``rt/a/b``."""
+    return "rt/" + ros_name.lstrip("/")
+
+
+_DOMAINS: dict[int, tuple[str, Any]] = {}  # Cyclone allows one configured domain per id
+
+
+def _domain(config: BusConfig) -> Any:
+    from cyclonedds.domain import Domain
+
+    xml = config.xml()
+    known = _DOMAINS.get(config.domain_id)
+    if known is None:
+        known = _DOMAINS[config.domain_id] = (xml, Domain(config.domain_id, xml))
+    elif known[0] != xml:
+        raise ValueError(
+            f"domain {config.domain_id} is already configured otherwise in this process"
+        )
+    return known[1]
+
+
+class Bus:
+    """A participant on one domain with the topics, readers and writers made through it."""
+
+    def __init__(self, config: BusConfig) -> None:
+        from cyclonedds.domain import DomainParticipant
+
+        self.config = config
+        self._domain = _domain(config)
+        self.participant = DomainParticipant(config.domain_id)
+        self._topics: dict[str, Any] = {}
+
+    def _topic(self, name: str, cls: type) -> Any:
+        from cyclonedds.topic import Topic
+
+        key = dds_topic(name)
+        if key not in self._topics:
+            self._topics[key] = Topic(self.participant, key, cls)
+        elif self._topics[key].data_type is not cls:
+            raise ValueError(f"topic {name!r} is {self._topics[key].data_type.__name__} here")
+        return self._topics[key]
+
+    def _qos(self, reliable: bool) -> Any:
+        from cyclonedds.core import Policy, Qos
+        from cyclonedds.util import duration
+
+        depth = self.config.depth
+        if reliable:
+            return Qos(
+                Policy.Reliability.Reliable(duration(milliseconds=100)),
+                Policy.History.KeepLast(depth),
+                Policy.Durability.Volatile,
+            )
+        return Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(depth),
+                   Policy.Durability.Volatile)  # fmt: skip
+
+    def writer(self, name: str, cls: type) -> Any:
+        """A writer with ROS 2's default profile (reliable)."""
+        from cyclonedds.pub import DataWriter
+
+        return DataWriter(self.participant, self._topic(name, cls), self._qos(reliable=True))
+
+    def reader(self, name: str, cls: type) -> Any:
+        """A reader, best effort unless ``reliable_subscriptions``."""
+        from cyclonedds.sub import DataReader
+
+        reliable = self.config.reliable_subscriptions
+        return DataReader(self.participant, self._topic(name, cls), self._qos(reliable))
+
+    def close(self) -> None:
+        """Delete the participant (and with it every reader, writer and topic)."""
+        self._topics.clear()
+        self.participant = None
+        self._domain = None

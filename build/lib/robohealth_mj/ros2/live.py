@@ -1,0 +1,130 @@
+"""Long-running loops on the bus: the monitor (``monitor source=ros2``) and simulated arms
+(``python -m robohealth_mj.robot``). Both stop cleanly on Ctrl-C or SIGTERM: the last
+``/diagnostics`` is published and the participants are closed."""
+
+from __future__ import annotations
+
+import signal
+import threading
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any
+
+from omegaconf import DictConfig
+
+from robohealth_mj.ros2 import require_dds
+from robohealth_mj.schema import GraphSample
+
+
+def bus_config(cfg: DictConfig) -> Any:
+    from robohealth_mj.ros2.bus import BusConfig
+
+    return BusConfig(
+        domain_id=int(cfg.domain_id),
+        interface=cfg.interface,
+        ignore_type_information=bool(cfg.ignore_type_information),
+        reliable_subscriptions=bool(cfg.get("reliable_subscriptions", False)),
+        depth=int(cfg.get("depth", 10)),
+    )
+
+
+@contextmanager
+def stop_on_signals() -> Iterator[threading.Event]:
+    """An event set by SIGINT or SIGTERM while the block runs (handlers restored after)."""
+    stop = threading.Event()
+    previous = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    for s in previous:
+        signal.signal(s, lambda *_: stop.set())
+    try:
+        yield stop
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+
+
+def arm_names(cfg: DictConfig) -> list[str]:
+    """The configured arms (a list, or ``count`` names from ``prefix``), this process's share."""
+    from robohealth_mj.ros2.node import in_partition
+
+    arms = list(cfg.arms) if cfg.arms else [f"{cfg.prefix}{k + 1}" for k in range(int(cfg.count))]
+    return [a for a in arms if in_partition(a, cfg.partition)]
+
+
+def run_monitor(
+    cfg: DictConfig,
+    runtime: Any,
+    duration_s: float | None,
+    on_diagnosis: Callable[[str, GraphSample, Any], None] | None = None,
+) -> dict[str, Any]:
+    """Diagnose the configured arms until the duration ends or a signal comes; each diagnosis
+    also goes to ``on_diagnosis(arm, sample, diagnosis)`` (the on-line evaluation)."""
+    require_dds()
+    from robohealth_mj.ros2.bus import Bus
+    from robohealth_mj.ros2.node import MonitorNode
+
+    arms = arm_names(cfg)
+    if not arms:
+        raise ValueError("ros2: no arms in this process's partition")
+    bus = Bus(bus_config(cfg))
+    node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
+                       stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
+                       layout=str(cfg.layout))  # fmt: skip
+    started = time.monotonic()
+    last_report = started
+    print(f"ros2 monitor: {len(arms)} arms on domain {cfg.domain_id} ({', '.join(arms[:5])}"
+          f"{' …' if len(arms) > 5 else ''}); Ctrl-C to stop", flush=True)  # fmt: skip
+    with stop_on_signals() as stop:
+        try:
+            while not stop.is_set():
+                now = time.monotonic()
+                if duration_s and now - started >= duration_s:
+                    break
+                if not node.poll():  # nothing completed: wait a poll period (an empty poll of
+                    time.sleep(float(cfg.poll_s))  # every reader is not free)
+                if now - last_report >= float(cfg.diagnostics_period_s):
+                    node.publish_diagnostics(time.time())
+                    last_report = now
+        finally:
+            node.publish_diagnostics(time.time())  # the last word on every arm
+            bus.close()
+    return {
+        arm: {
+            "samples": s.samples,
+            "problems": s.problems,
+            "late": s.late,
+            "duplicates": s.duplicates,
+            "last_problem": s.last_problem,
+        }
+        for arm, s in node.arms.items()
+    }
+
+
+def run_robot(cfg: DictConfig, stream: Iterator[tuple[float, GraphSample]]) -> int:
+    """Publish each sample of ``stream`` on every configured arm, paced at ``speed`` x real
+    time (0: as fast as possible); returns the ticks published."""
+    require_dds()
+    from robohealth_mj.ros2.bus import Bus
+    from robohealth_mj.ros2.node import ArmPublisher
+
+    bus = Bus(bus_config(cfg.ros2))
+    arms = [ArmPublisher(bus, arm, layout=str(cfg.ros2.layout)) for arm in arm_names(cfg.ros2)]
+    time.sleep(float(cfg.discovery_s))  # let subscribers match before the first sample
+    ticks, started, t0 = 0, time.perf_counter(), None
+    with stop_on_signals() as stop:
+        try:
+            for t, sample in stream:
+                if stop.is_set():
+                    break
+                t0 = t if t0 is None else t0
+                if cfg.speed:
+                    delay = (t - t0) / cfg.speed - (time.perf_counter() - started)
+                    if delay > 0:
+                        time.sleep(delay)
+                for arm in arms:
+                    arm.publish(sample)
+                ticks += 1
+        finally:
+            time.sleep(0.2)  # reliable writers flush before the participant goes
+            bus.close()
+    return ticks

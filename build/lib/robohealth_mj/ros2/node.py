@@ -1,0 +1,276 @@
+"""The monitor as a live ROS 2 participant, and simulated arms publishing as a robot would.
+
+``MonitorNode`` subscribes to each arm's topics (the bag layout under ``/<arm>``), assembles
+samples by stamp (:mod:`robohealth_mj.ros2.assembly`), diagnoses every arm in one batched runtime
+step per poll, and publishes each diagnosis on ``/<arm>/health_diagnosis`` and, at a fixed
+period, one ``DiagnosticStatus`` per arm on ``/diagnostics`` (level from the alarm; WARN with the
+reason for a bad message; STALE when an arm stops publishing). A bad message marks its arm only.
+"""
+
+from __future__ import annotations
+
+import time
+import zlib
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from robohealth_mj.bags.messages import MessageFactory
+from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.ros2.assembly import ArmAssembler
+from robohealth_mj.ros2.bus import Bus
+from robohealth_mj.ros2.idl import TYPES, IdlStore
+from robohealth_mj.schema import GraphSample
+
+DIAGNOSTICS_TOPIC = "/diagnostics"
+
+
+def arm_topics(arm: str, topics: BagTopics | None = None) -> BagTopics:
+    """The bag layout's topic names under the arm's namespace (``/arm1/joint_states`` …)."""
+    base = topics or BagTopics.load()
+    fields = {k: f"/{arm}/{v.lstrip('/')}" for k, v in vars(base).items()}
+    return replace(base, **fields)
+
+
+def in_partition(arm: str, partition: str | None) -> bool:
+    """``partition="k/n"``: this process's share of a fleet split across ``n`` processes by a
+    stable hash of the arm name (no coordinator: every process computes the same split)."""
+    if not partition:
+        return True
+    k, n = (int(v) for v in partition.split("/"))
+    if not 0 <= k < n:
+        raise ValueError(f"partition {partition!r}: need k/n with 0 <= k < n")
+    return zlib.crc32(arm.encode()) % n == k
+
+
+LAYOUTS = ("per_sensor", "aggregated", "joints")
+
+
+def layout_topics(topics: BagTopics, layout: str) -> dict[str, str]:
+    """The topics (-> message type) one sample travels on in ``layout``: ``per_sensor`` (the bag
+    layout, 15 messages a tick), ``aggregated`` (the snapshot in one array, and the truth) or
+    ``joints`` (a stock arm's own: joint state and tracking error, and the truth where there is
+    one; no sensor package, so those channels stay zero)."""
+    if layout not in LAYOUTS:
+        raise ValueError(f"ros2.layout must be one of {LAYOUTS}, got {layout!r}")
+    if layout == "aggregated":
+        return topics.aggregated_topics()
+    every = topics.sample_topics()
+    if layout == "joints":
+        own = (topics.joint_states, topics.joint_errors, topics.fault_state)
+        return {t: every[t] for t in own}
+    return every
+
+
+class ArmPublisher:
+    """One simulated or replayed arm publishing its samples as a robot driver would."""
+
+    def __init__(
+        self, bus: Bus, arm: str, topics: BagTopics | None = None, layout: str = "per_sensor"
+    ) -> None:
+        self.arm, self.topics, self.layout = arm, arm_topics(arm, topics), layout
+        self.factory = MessageFactory(IdlStore())
+        self.writers = {
+            name: bus.writer(name, TYPES[kind])
+            for name, kind in layout_topics(self.topics, layout).items()
+        }
+
+    def messages(self, sample: GraphSample, topics: BagTopics | None = None) -> list[tuple]:
+        """``(topic, message)`` of one sample in this arm's layout (``topics``: other names)."""
+        topics = topics or self.topics
+        if self.layout == "aggregated":
+            return [
+                (topics.aggregated, self.factory.aggregated(sample)),
+                (topics.fault_state, self.factory.fault_state(sample)),
+            ]
+        messages = self.factory.sample_messages(sample, topics)
+        if self.layout == "joints":
+            own = layout_topics(topics, "joints")
+            messages = [(t, m) for t, m in messages if t in own]
+        return messages
+
+    def publish(self, sample: GraphSample) -> None:
+        for topic, msg in self.messages(sample):
+            self.writers[topic].write(msg)
+
+    def publish_built(self, messages: list[Any]) -> None:
+        """Messages already built for one tick (in ``sample_topics`` order), shared by arms that
+        replay the same sample: the benchmark's publishers build once and write N times."""
+        for writer, msg in zip(self.writers.values(), messages, strict=True):
+            writer.write(msg)
+
+
+@dataclass
+class ArmState:
+    """What ``/diagnostics`` says of one arm."""
+
+    assembler: ArmAssembler
+    readers: list[tuple[str, type, Any]]  # (topic, message class, reader)
+    last_sample_wall: float | None = None
+    last_diagnosis: Any = None
+    problem: str | None = None  # the latest, until /diagnostics has reported it
+    last_problem: str | None = None
+    problems: int = 0
+    duplicates: int = 0  # repeated identical messages (re-deliveries), dropped
+    late: int = 0  # messages for ticks already reported missing, dropped
+    samples: int = 0
+    diagnoses: list[Any] = field(default_factory=list)
+
+
+class MonitorNode:
+    """Diagnoses a fleet of arms on the bus; ``poll`` once per loop iteration."""
+
+    def __init__(
+        self,
+        bus: Bus,
+        runtime: Any,
+        arms: list[str],
+        topics: BagTopics | None = None,
+        require_truth: bool = True,
+        stale_s: float = 1.0,
+        keep_diagnoses: bool = False,
+        on_diagnosis: Callable[[str, GraphSample, Any], None] | None = None,
+        layout: str = "per_sensor",
+    ) -> None:
+        self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
+        self.keep_diagnoses, self.on_diagnosis = keep_diagnoses, on_diagnosis
+        # where the monitor's time goes (the benchmark reports it): take (DDS read and CDR
+        # decoding), assemble, diagnose (runtime), publish (the diagnoses' writes)
+        self.seconds: dict[str, float] = dict.fromkeys(
+            ("take", "assemble", "diagnose", "publish"), 0.0
+        )
+        self._publishing = 0.0
+        self.factory = MessageFactory(IdlStore())
+        self.arms: dict[str, ArmState] = {}
+        self.diagnosis_writers: dict[str, Any] = {}
+        for arm in arms:
+            names = arm_topics(arm, topics)
+            kinds = layout_topics(names, layout)
+            aggregated = names.aggregated if layout == "aggregated" else None
+            assembler = ArmAssembler(arm, names, require_truth=require_truth,
+                                     aggregated=aggregated, sensors=layout != "joints")  # fmt: skip
+            readers = [
+                (t, TYPES[kinds[t]], bus.reader(t, TYPES[kinds[t]]))
+                for t in assembler.topic_names()
+            ]
+            self.arms[arm] = ArmState(assembler, readers)
+            self.diagnosis_writers[arm] = bus.writer(names.health_diagnosis, TYPES[
+                "diagnostic_msgs/msg/DiagnosticArray"])  # fmt: skip
+        self.diagnostics = bus.writer(
+            DIAGNOSTICS_TOPIC, TYPES["diagnostic_msgs/msg/DiagnosticArray"]
+        )
+
+    def poll(self, max_per_reader: int = 256) -> int:
+        """Take what has arrived, diagnose the completed samples; returns how many."""
+        now = time.monotonic()
+        clock = time.perf_counter
+        submitted: list[tuple[str, GraphSample]] = []
+        for arm, state in self.arms.items():
+            for topic, kind, reader in state.readers:
+                t0 = clock()
+                taken = reader.take(N=max_per_reader)  # the DDS read and CDR decoding
+                t1 = clock()
+                self.seconds["take"] += t1 - t0
+                for msg in taken:
+                    if not isinstance(msg, kind):
+                        continue  # an instance-state notice (a writer went away), not data
+                    self._collect(arm, state, state.assembler.add(topic, msg), now, submitted)
+                self.seconds["assemble"] += clock() - t1
+            t1 = clock()  # every reader of the arm taken: now a missing message is missing
+            self._collect(arm, state, state.assembler.settle(), now, submitted)
+            self.seconds["assemble"] += clock() - t1
+        t2 = clock()
+        # One sample per arm per runtime step: every sample gets its own decision (a step given
+        # several samples of one stream decides only the last), and the arms share each step.
+        by_arm: dict[str, list[GraphSample]] = {}
+        for arm, sample in submitted:
+            by_arm.setdefault(arm, []).append(sample)
+        for round_ in range(max((len(v) for v in by_arm.values()), default=0)):
+            queued = {}
+            for arm, samples in by_arm.items():
+                if round_ < len(samples):
+                    invalid = self.runtime.submit(arm, samples[round_])
+                    if invalid is not None:
+                        self._record(arm, invalid, samples[round_])
+                    else:
+                        queued[arm] = samples[round_]
+            for d in self.runtime.tick():
+                self._record(d.stream_id, d, queued[d.stream_id])
+        self.seconds["diagnose"] += clock() - t2 - self._publishing
+        self.seconds["publish"] += self._publishing
+        self._publishing = 0.0
+        return len(submitted)
+
+    @staticmethod
+    def _collect(arm: str, state: ArmState, got: Any, now: float, submitted: list) -> None:
+        for problem in got.problems:
+            state.problem = state.last_problem = problem
+            state.problems += 1
+        state.duplicates += got.duplicates
+        state.late += got.late
+        for sample in got.samples:
+            submitted.append((arm, sample))
+            state.last_sample_wall = now
+
+    def _record(self, arm: str, d: Any, sample: GraphSample) -> None:
+        state = self.arms[arm]
+        state.last_diagnosis, state.samples = d, state.samples + 1
+        if self.keep_diagnoses:
+            state.diagnoses.append(d)
+        if self.on_diagnosis is not None:
+            self.on_diagnosis(arm, sample, d)
+        fleet = self.runtime.fleet
+        t0 = time.perf_counter()
+        self.diagnosis_writers[arm].write(
+            self.factory.health_diagnosis(d, fleet.classes, fleet.joints)
+        )
+        self._publishing += time.perf_counter() - t0
+
+    def arm_status(self, arm: str, now: float) -> Any:
+        """One arm's ``DiagnosticStatus``: STALE without recent samples, WARN with the last
+        problem, else the last diagnosis's level."""
+        state, status = self.arms[arm], self.factory.Status
+        fleet = self.runtime.fleet
+        d = state.last_diagnosis
+        if d is not None:
+            msg = self.factory.health_status(
+                d, fleet.classes, fleet.joints, f"robohealth/{arm}", arm
+            )
+        else:
+            msg = status(level=status.STALE, name=f"robohealth/{arm}", message="no sample yet",
+                         hardware_id=arm, values=[])  # fmt: skip
+        if state.last_sample_wall is not None and now - state.last_sample_wall > self.stale_s:
+            msg.level = status.STALE
+            msg.message = f"no sample for {now - state.last_sample_wall:.1f} s"
+        elif state.problem is not None:
+            msg.level = max(int(msg.level), status.WARN)
+            msg.message = f"bad input: {state.problem}"
+        for key in ("problems", "late", "duplicates"):
+            msg.values.append(self.factory.KeyValue(key=key, value=str(getattr(state, key))))
+        return msg
+
+    def check_writers(self) -> None:
+        """A writer on an arm's topic that cannot match (another message type, or a QoS the
+        reader cannot take) marks that arm: DDS reports it as a requested-incompatible QoS
+        (type consistency for a wrong type)."""
+        for state in self.arms.values():
+            for topic, kind, reader in state.readers:
+                status = reader.get_requested_incompatible_qos_status()
+                if status.total_count_change:
+                    state.problem = state.last_problem = (
+                        f"topic '{topic}': a writer that cannot match a {kind.__name__} reader "
+                        f"(wrong type or QoS; policy id {status.last_policy_id})"
+                    )
+                    state.problems += 1
+
+    def publish_diagnostics(self, stamp: float) -> Any:
+        self.check_writers()
+        now = time.monotonic()
+        array = self.factory.DiagnosticArray(
+            header=self.factory.header(stamp),
+            status=[self.arm_status(arm, now) for arm in self.arms],
+        )
+        self.diagnostics.write(array)
+        for state in self.arms.values():
+            state.problem = None  # a problem is reported once, then the arm recovers
+        return array

@@ -1,0 +1,468 @@
+"""The fleet runtime: many 20 Hz streams diagnosed in bulk, one batch per tick.
+
+Samples arrive as arrays, one row per sample: ``slots [R]`` (from :meth:`FleetRuntime.register`),
+``sample_index [R]``, ``t [R]``, ``x [R, 12, F]`` (and optionally ``layout_ok [R]``, whether the
+sender's node order is the schema's). Every check is vectorised over the rows, each stream's
+window lives in preallocated arrays (:mod:`robohealth_mj.runtime.incremental`), the model runs
+once per tick on every stream whose window is full, each stream's evidence accumulates over its
+windows (:mod:`robohealth_mj.runtime.evidence`; reset with the window on a gap), and the alarms
+update in bulk on the accumulated probabilities. A bad row
+never raises: it comes back flagged with its reason. Several rows from one stream in one tick
+(a burst) are taken in order, up to ``max_burst``; the rest are flagged and dropped.
+"""
+
+from __future__ import annotations
+
+import base64
+import gc
+import logging
+import time
+from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from robohealth_mj import schema
+from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
+from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
+from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
+
+log = logging.getLogger(__name__)
+
+DECIDED, WARMING, INVALID, NO_MODEL, BUFFERED = 0, 1, 2, 3, 4
+JOINT_SCORES = ("softmax", "sigmoid")  # how joint logits become scores (ONNX metadata)
+
+_FLAGS = np.zeros((schema.N_NODES, 2), np.float32)
+_FLAGS[: schema.N_JOINTS, 0] = 1.0
+_FLAGS[schema.N_JOINTS :, 1] = 1.0
+
+
+@dataclass
+class TickResult:
+    """One row per submitted sample, in submission order (bursts: each sample in turn)."""
+
+    slot: np.ndarray  # [R]
+    sample_index: np.ndarray  # [R]
+    t: np.ndarray  # [R]
+    status: np.ndarray  # [R] DECIDED, WARMING, INVALID, NO_MODEL or BUFFERED (burst catch-up)
+    probs: np.ndarray  # [R, C] class probabilities (zero unless decided)
+    accumulated: np.ndarray  # [R, C] the evidence accumulated over windows the alarms read
+    joint_scores: (
+        np.ndarray
+    )  # [R, J] joint scores, softmax or sigmoid as trained (zero unless decided)
+    alarm: np.ndarray  # [R] alarms.NONE/RAISED/HELD/CLEARED (decided rows)
+    alarm_class: np.ndarray  # [R] alarmed class index, 0 when none
+    alarm_joint: np.ndarray  # [R] alarmed joint index, -1 when none
+    reasons: dict[int, str] = field(default_factory=dict)  # row -> why flagged / undecided
+    inference_ms: float = 0.0
+
+    def __len__(self) -> int:
+        return len(self.slot)
+
+
+def _empty(n: int, classes: int, joints: int) -> dict[str, np.ndarray]:
+    return {
+        "status": np.full(n, INVALID, np.int8),
+        "probs": np.zeros((n, classes), np.float32),
+        "accumulated": np.zeros((n, classes), np.float32),
+        "joint_scores": np.zeros((n, joints), np.float32),
+        "alarm": np.zeros(n, np.int8),
+        "alarm_class": np.zeros(n, np.int64),
+        "alarm_joint": np.full(n, -1, np.int64),
+    }
+
+
+def freeze_startup_heap() -> None:
+    """Move every object alive now (torch, onnxruntime, the model) out of the cyclic garbage
+    collector's reach. A full collection walks them all (about 0.2 s with torch imported), which
+    would land inside some tick; a long-running runtime process calls this once after start-up."""
+    gc.collect()
+    gc.freeze()
+
+
+def _softmax(z: np.ndarray) -> np.ndarray:
+    e = np.exp(z - z.max(axis=-1, keepdims=True))
+    return e / e.sum(axis=-1, keepdims=True)
+
+
+def joint_scores_from_logits(logits: np.ndarray, kind: str) -> np.ndarray:
+    """``[B, J]`` joint logits -> scores as the model was trained: ``softmax`` over the joints
+    (which joint is at fault) or ``sigmoid`` per joint (is this joint at fault)."""
+    if kind == "softmax":
+        return _softmax(logits)
+    return 0.5 * (1.0 + np.tanh(0.5 * logits))  # sigmoid, no overflow
+
+
+class FleetRuntime:
+    """Per-stream windows, bulk validation, one model call per tick, alarms."""
+
+    def __init__(
+        self,
+        model_path: str | Path | None,
+        *,
+        threads: int = 1,
+        alarm: AlarmPolicy | None = None,
+        evidence: EvidencePolicy | None = None,
+        incremental: bool = True,
+        capacity: int = 64,
+        max_streams: int = 8192,
+        max_burst: int = 8,
+        max_gap_s: float = 0.25,
+        idle_ticks: int = 1200,
+        shards: int = 1,
+    ) -> None:
+        self.max_streams, self.max_burst = max_streams, max_burst
+        self.max_gap_s, self.idle_ticks = max_gap_s, idle_ticks
+        self.shards, self.threads = max(1, shards), threads
+        capacity = max(1, min(capacity, max_streams))
+        self._pool = ThreadPoolExecutor(self.shards) if self.shards > 1 else None
+        self.window, self.model_id, self.problem = 16, "none", None
+        self.joint_scores = "softmax"
+        self.classes, self.joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
+        self.engine: IncrementalEngine | WindowedEngine | None = None
+        self.mode = "none"
+        self._load(model_path, threads, incremental, capacity)
+        self.alarms = AlarmBank(alarm or AlarmPolicy(), len(self.joints), capacity)
+        self.evidence = EvidenceBank(evidence or EvidencePolicy(), len(self.classes), capacity)
+        self.last_t = np.full(capacity, -np.inf)
+        self.last_index = np.full(capacity, -1, np.int64)
+        self.last_seen = np.zeros(capacity, np.int64)
+        self.active = np.zeros(capacity, bool)
+        self.ids: dict[str, int] = {}
+        self.names: list[str | None] = [None] * capacity
+        self.ticks = 0
+
+    # model
+
+    def _load(self, model_path, threads: int, incremental: bool, capacity: int) -> None:
+        if not model_path:
+            self.problem = "no model configured"
+        elif not Path(model_path).is_file():
+            self.problem = f"no model file at {model_path}"
+        else:
+            try:
+                self._open(Path(model_path), threads, incremental, capacity)
+            except Exception as exc:  # a broken model must not take the monitor down
+                self.engine = None
+                self.problem = f"model {model_path} unusable: {type(exc).__name__}: {exc}"
+        if self.engine is None:
+            log.warning(
+                "runtime running without a model (%s): every diagnosis will say 'no model', "
+                "fault absent, confidence 0",
+                self.problem,
+            )
+
+    def _open(self, path: Path, threads: int, incremental: bool, capacity: int) -> None:
+        import onnxruntime as ort
+
+        from robohealth_mj.runtime.metadata import read_metadata
+
+        meta = read_metadata(path)
+        if meta.get("node_names") != list(schema.NODE_NAMES):
+            raise ValueError("model node order differs from this schema")
+        if meta.get("schema_version") != schema.SCHEMA_VERSION:
+            raise ValueError(
+                f"model schema {meta.get('schema_version')} != {schema.SCHEMA_VERSION}"
+            )
+        options = ort.SessionOptions()
+        options.intra_op_num_threads = threads
+        providers = ort.get_available_providers()
+
+        def session(model: str | bytes):
+            return ort.InferenceSession(model, options, providers=providers)
+
+        self.window = int(meta["window"])
+        self.classes, self.joints = meta["classes"], meta["joints"]
+        # models exported before the key existed were all trained with the softmax joint loss
+        self.joint_scores = meta.get("joint_scores", "softmax")
+        if self.joint_scores not in JOINT_SCORES:
+            raise ValueError(f"joint_scores {self.joint_scores!r} is not one of {JOINT_SCORES}")
+        if incremental and "incremental_encode" in meta:
+            self.engine = IncrementalEngine(
+                session(base64.b64decode(meta["incremental_encode"])),
+                session(base64.b64decode(meta["incremental_head"])),
+                self.window,
+                int(meta["incremental_nodes"]),
+                schema.N_FEATURES,
+                int(meta["incremental_channels"]),
+                int(meta["first_signal"]),
+                capacity,
+            )
+            self.mode = "incremental"
+        else:
+            self.engine = WindowedEngine(
+                session(str(path)), self.window, schema.N_NODES, schema.N_FEATURES, capacity
+            )
+            self.mode = "windowed"
+        self.model_id = meta["model_id"]
+
+    # streams
+
+    @property
+    def capacity(self) -> int:
+        return len(self.active)
+
+    def register(self, stream_ids: Sequence[str]) -> np.ndarray:
+        """Slots of these streams (new ones get free slots; -1 past ``max_streams``)."""
+        out = np.empty(len(stream_ids), np.int64)
+        for k, sid in enumerate(stream_ids):
+            slot = self.ids.get(sid)
+            if slot is None:
+                slot = self._allocate(sid)
+            out[k] = slot
+        return out
+
+    def _allocate(self, sid: str) -> int:
+        if len(self.ids) >= self.max_streams:
+            return -1
+        free = np.flatnonzero(~self.active)
+        if not len(free):
+            if self.capacity >= self.max_streams:
+                return -1
+            self._grow(min(2 * self.capacity, self.max_streams))
+            free = np.flatnonzero(~self.active)
+        slot = int(free[0])
+        self.active[slot], self.names[slot], self.ids[sid] = True, sid, slot
+        self.last_t[slot], self.last_index[slot] = -np.inf, -1
+        self.last_seen[slot] = self.ticks
+        if self.engine is not None:
+            self.engine.reset(np.array([slot]))
+        self.alarms.reset(np.array([slot]))
+        self.evidence.reset(np.array([slot]))
+        return slot
+
+    def _grow(self, capacity: int) -> None:
+        if self.engine is not None:
+            self.engine.ensure(capacity)
+        self.alarms.ensure(capacity)
+        self.evidence.ensure(capacity)
+        n = capacity - self.capacity
+        self.last_t = np.concatenate([self.last_t, np.full(n, -np.inf)])
+        self.last_index = np.concatenate([self.last_index, np.full(n, -1, np.int64)])
+        self.last_seen = np.concatenate([self.last_seen, np.zeros(n, np.int64)])
+        self.active = np.concatenate([self.active, np.zeros(n, bool)])
+        self.names += [None] * n
+
+    def release(self, slots: np.ndarray) -> None:
+        """Free these streams' slots (their windows and alarms are forgotten)."""
+        for slot in np.asarray(slots, np.int64).tolist():
+            name = self.names[slot]
+            if name is not None:
+                del self.ids[name]
+            self.names[slot], self.active[slot] = None, False
+
+    @property
+    def streams(self) -> list[str]:
+        return list(self.ids)
+
+    # the tick
+
+    def step(
+        self,
+        slots: np.ndarray,
+        sample_index: np.ndarray,
+        t: np.ndarray,
+        x: np.ndarray,
+        layout_ok: np.ndarray | None = None,
+    ) -> TickResult:
+        """Diagnose one tick's samples (rows); see the module docstring."""
+        slots = np.asarray(slots, np.int64)
+        n = len(slots)
+        sample_index = np.asarray(sample_index, np.int64)
+        t = np.asarray(t, np.float64)
+        out = _empty(n, len(self.classes), len(self.joints))
+        reasons: dict[int, str] = {}
+        self.ticks += 1
+        x = np.asarray(x, np.float32)
+        if x.shape[1:] != (schema.N_NODES, schema.N_FEATURES):
+            for k in range(n):
+                reasons[k] = f"x has shape {x.shape[1:]}, not {(schema.N_NODES, schema.N_FEATURES)}"
+            return TickResult(slots, sample_index, t, reasons=reasons, **out)
+        known = (slots >= 0) & (slots < self.capacity)
+        known[known] &= self.active[slots[known]]
+        rank, size = _burst_rank(np.where(known, slots, -1 - np.arange(n)))
+        # a burst is buffered in order and decided once, with its last sample: the alarms count
+        # ticks, and a stream catching up must not advance them several times in one tick
+        final = rank == np.minimum(size, self.max_burst) - 1
+        inference = 0.0
+        for r in range(int(rank.max(initial=-1)) + 1):
+            rows = np.flatnonzero(rank == r)
+            if r >= self.max_burst:
+                for k in rows.tolist():
+                    reasons[k] = (
+                        f"burst: more than {self.max_burst} samples from this stream in one "
+                        "tick; dropped"
+                    )
+                continue
+            ok_layout = None if layout_ok is None else np.asarray(layout_ok, bool)[rows]
+            inference += self._round(
+                rows, slots[rows], sample_index[rows], t[rows], x[rows], known[rows], ok_layout,
+                final[rows], out, reasons,
+            )  # fmt: skip
+        self._release_idle()
+        return TickResult(slots, sample_index, t, reasons=reasons, inference_ms=inference, **out)
+
+    def _round(self, rows, slots, index, t, x, known, layout_ok, final, out, reasons) -> float:
+        """Rows with distinct slots: validate, buffer, infer (``final`` rows), alarm. Returns
+        the model step's ms."""
+        bad = _validate(x, t, known, layout_ok)  # [n] reason code, 0 = fine
+        s = np.where(known, slots, 0)
+        backwards = (bad == 0) & ((t <= self.last_t[s]) | (index <= self.last_index[s]))
+        bad[backwards] = _BACKWARDS
+        good = bad == 0
+        gs, gi, gt = s[good], index[good], t[good]
+        gap = (self.last_index[gs] >= 0) & (
+            (gi != self.last_index[gs] + 1) | (gt - self.last_t[gs] > self.max_gap_s)
+        )
+        for k in np.flatnonzero(bad).tolist():
+            reasons[int(rows[k])] = _reason(bad[k], x[k], t[k], index[k], s[k], self)
+        self.last_seen[gs] = self.ticks
+        if self.engine is None:
+            out["status"][rows[good]] = NO_MODEL
+            for k in rows[good].tolist():
+                reasons[k] = self.problem or "no model"
+            self.last_t[gs], self.last_index[gs] = gt, gi
+            return 0.0
+        gap_rows = rows[good][gap]
+        for k, slot, new in zip(gap_rows.tolist(), gs[gap].tolist(), gi[gap].tolist(), strict=True):
+            reasons[k] = (
+                f"gap in sample_index ({int(self.last_index[slot])} -> {new}) or over "
+                f"{self.max_gap_s} s of time; window restarted"
+            )
+        if gap.any():  # the window restarts, and the evidence with it
+            self.engine.reset(gs[gap])
+            self.evidence.reset(gs[gap])
+        self.last_t[gs], self.last_index[gs] = gt, gi
+        start = time.perf_counter()
+        decide = final[good]
+        full, outputs = self._model_step(gs, x[good], decide)
+        elapsed = (time.perf_counter() - start) * 1e3
+        warming = rows[good][~full & ~gap]
+        out["status"][warming] = WARMING
+        for k in warming.tolist():
+            reasons[k] = "warming up: window not full yet"
+        buffered = rows[good][full & ~decide]
+        out["status"][buffered] = BUFFERED
+        for k in buffered.tolist():
+            reasons[k] = "burst: buffered; decided with this stream's last sample of the tick"
+        full &= decide
+        ready = gs[full]
+        if not len(ready):
+            return elapsed
+        probs = _softmax(outputs[0])
+        joint_scores = joint_scores_from_logits(outputs[1], self.joint_scores)
+        accumulated = self.evidence.update(ready, probs)
+        state, alarm, joint = self.alarms.update(ready, accumulated, joint_scores)
+        target = rows[good][full]
+        out["status"][target] = DECIDED
+        out["probs"][target], out["joint_scores"][target] = probs, joint_scores
+        out["accumulated"][target] = accumulated
+        out["alarm"][target], out["alarm_class"][target] = state, alarm
+        out["alarm_joint"][target] = joint
+        return elapsed
+
+    def _model_step(
+        self, slots: np.ndarray, x: np.ndarray, decide: np.ndarray
+    ) -> tuple[np.ndarray, list[np.ndarray]]:
+        """Buffer ``x`` and run the model on the ``decide`` streams whose window is full, in
+        ``shards`` contiguous parts on as many threads (numpy and onnxruntime release the GIL, so
+        the parts run on separate cores). Returns the full mask and the outputs of the rows that
+        are full and decided."""
+        shards = self.shards if len(slots) >= 64 * self.shards else 1  # small: not worth a thread
+        parts = [p for p in np.array_split(np.arange(len(slots)), shards) if len(p)]
+        if not parts:
+            return np.zeros(0, bool), []
+
+        def shard(p: np.ndarray) -> tuple[np.ndarray, list[np.ndarray] | None]:
+            s = slots[p]
+            self.engine.push(s, x[p])
+            full = self.engine.full(s)
+            ready = full & decide[p]
+            return full, self.engine.infer(s[ready]) if ready.any() else None
+
+        done = list(self._pool.map(shard, parts)) if len(parts) > 1 else [shard(parts[0])]
+        full = np.concatenate([f for f, _ in done])
+        outputs = [o for _, o in done if o is not None]
+        return full, [np.concatenate(k) for k in zip(*outputs, strict=True)] if outputs else []
+
+    def _release_idle(self) -> None:
+        if self.ticks % 20:
+            return  # once a second of ticks is enough
+        idle = self.active & (self.ticks - self.last_seen > self.idle_ticks)
+        if idle.any():
+            self.release(np.flatnonzero(idle))
+
+    def close(self) -> None:
+        """Stop the shard threads; later steps run on the calling thread."""
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
+            self.shards = 1
+
+    def describe(self) -> dict:
+        return {
+            "model_id": self.model_id,
+            "window": self.window,
+            "mode": self.mode,
+            "threads": self.threads,
+            "joint_scores": self.joint_scores,
+            "problem": self.problem,
+        }
+
+
+_UNKNOWN, _LAYOUT, _TIME, _NAN, _FLAG, _STRAY, _BACKWARDS = range(1, 8)
+
+
+def _burst_rank(slots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each row, how many earlier rows of this tick came from the same slot, and how many
+    rows that slot has in all."""
+    order = np.argsort(slots, kind="stable")
+    sorted_slots = slots[order]
+    starts = np.flatnonzero(np.r_[True, sorted_slots[1:] != sorted_slots[:-1]])
+    counts = np.diff(np.r_[starts, len(slots)])
+    group_start = np.repeat(starts, counts)
+    rank, size = np.empty(len(slots), np.int64), np.empty(len(slots), np.int64)
+    rank[order] = np.arange(len(slots)) - group_start
+    size[order] = np.repeat(counts, counts)
+    return rank, size
+
+
+def _validate(
+    x: np.ndarray, t: np.ndarray, known: np.ndarray, layout_ok: np.ndarray | None
+) -> np.ndarray:
+    """Reason code per row (0 = valid), the first failing check in this order."""
+    checks = [
+        ~known,
+        np.zeros(len(x), bool) if layout_ok is None else ~layout_ok,
+        ~np.isfinite(t),
+        ~np.isfinite(x).all(axis=(1, 2)),
+        (x[:, :, :2] != _FLAGS).any(axis=(1, 2)),
+        (x[:, : schema.N_JOINTS, schema.SENSOR_CHANNELS] != 0.0).any(axis=(1, 2)),
+    ]
+    code = np.zeros(len(x), np.int64)
+    for value, failed in reversed(list(enumerate(checks, start=1))):
+        code[failed] = value
+    return code
+
+
+def _reason(code: int, x: np.ndarray, t: float, index: int, slot: int, fleet: FleetRuntime) -> str:
+    """The message for one flagged row (only bad rows pay for this)."""
+    if code == _UNKNOWN:
+        return f"unknown stream or stream limit ({fleet.max_streams}) reached"
+    if code == _LAYOUT:
+        return f"node order differs from the schema's {list(schema.NODE_NAMES)}"
+    if code == _TIME:
+        return "field 't': not finite"
+    if code == _NAN:
+        node, feat = np.argwhere(~np.isfinite(x))[0]
+        return f"field 'x[{schema.NODE_NAMES[node]}].{schema.FEATURE_NAMES[feat]}': NaN or Inf"
+    if code == _FLAG:
+        return "field 'x.is_joint/is_sensor': node-type indicators do not match the node order"
+    if code == _STRAY:
+        return "field 'x': joint nodes must zero the sensor channels"
+    return (
+        f"time went backwards: t={t} (sample_index {index}) after t={fleet.last_t[slot]} "
+        f"(sample_index {fleet.last_index[slot]})"
+    )

@@ -1,0 +1,49 @@
+"""Where samples come from for the monitor and the simulated robot: the simulator itself, or a
+recording (graphs.jsonl or bag) replayed."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+
+from robohealth_mj.bags import is_bag
+from robohealth_mj.bags.reader import read_bag_samples
+from robohealth_mj.common.config import compose_config
+from robohealth_mj.logs import is_log, log_samples
+from robohealth_mj.schema import FaultLabel, GraphSample, SchemaError, validate_sample
+
+
+def sim_stream(
+    overrides: list[str], duration_s: float
+) -> Iterator[tuple[float, GraphSample, FaultLabel]]:
+    """GraphSamples straight from the simulator (with its fault schedule)."""
+    from robohealth_mj.recording.recorder import build_simulator, chunk_features, segment_info
+
+    sim = build_simulator(compose_config("record", ["session.progress=false", *overrides]))
+    for chunk in sim.run(round(duration_s / sim.tick_s)):
+        first, x, segment = sim.tick - len(chunk.t), chunk_features(chunk), segment_info(sim, chunk)
+        for k, t in enumerate(chunk.t.tolist()):
+            sample = GraphSample("sim", first + k, t, x[k].astype("float32"), chunk.fault, segment)
+            yield t, sample, chunk.fault
+
+
+def replay_stream(path: str) -> Iterator[tuple[float, str | GraphSample, FaultLabel | None]]:
+    """``(t, sample, truth)`` per recorded sample: a graphs.jsonl's lines (a line that does not
+    parse goes to the runtime as it is, which flags it), a bag's assembled samples or a
+    controller log's ticks."""
+    if is_log(path):  # no ground truth: read as healthy, so evaluate counts false alarms
+        for sample in log_samples(path):
+            yield sample.t, sample, sample.fault
+        return
+    if is_bag(path):
+        for sample in read_bag_samples(path):
+            yield sample.t, sample, sample.fault
+        return
+    with open(path, encoding="utf-8") as handle:
+        for number, line in enumerate(handle, start=1):
+            try:
+                sample = validate_sample(json.loads(line), source=path, line=number)
+            except (ValueError, SchemaError):
+                yield 0.0, line, None
+                continue
+            yield sample.t, sample, sample.fault

@@ -1,0 +1,254 @@
+"""The trajectory curriculum (thesis §2.3.2): sweeps, coordinated pairs and whole-arm motion;
+and, for probing programs unlike those, pick-and-place and palletising cycles as taught on a
+pendant (point-to-point moves with dwells, family ``pick_place``; not in the default families).
+
+Speed scales multiply the base excitation frequency; payload scales multiply a nominal payload.
+Segments are shuffled per pass by the session seed. Each segment starts at the previous segment's
+rest pose and ends at rest at its own centre pose, so the reference is smooth (C2) across segments.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import cache
+
+import numpy as np
+
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.schema import N_JOINTS
+
+FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place")
+WAVEFORMS = ("sine", "triangle", "compound")
+TASKS = ("pick_place", "palletise")  # the pick_place family's programs
+LEG_S = 0.8  # the shortest point-to-point move at speed scale 1, s
+JOINT_SPEED = 1.0  # rad/s: the fastest joint's peak speed in a move at speed scale 1
+LIFT_RAD = (0.0, -0.25, 0.35, -0.1, 0.0, 0.0)  # from a pick or place pose to above it
+
+
+def _raw_waveform(name: str, phi: np.ndarray) -> np.ndarray:
+    if name == "sine":
+        return np.sin(phi)
+    if name == "triangle":  # a triangle with rounded turns, so acceleration stays bounded
+        return (2.0 / np.pi) * np.arcsin(0.92 * np.sin(phi))
+    if name == "compound":
+        return np.sin(phi) + 0.35 * np.sin(2.0 * phi + np.pi / 4)
+    raise InputError(f"unknown waveform {name!r}; known: {WAVEFORMS}")
+
+
+@cache
+def _slope_norm(name: str) -> float:
+    """Largest |dw/dphi| of a raw waveform, so every normalised waveform has unit peak slope."""
+    phi = np.linspace(0.0, 2.0 * np.pi, 20001)
+    return float(np.max(np.abs(np.gradient(_raw_waveform(name, phi), phi))))
+
+
+def waveform(name: str, phi: np.ndarray) -> np.ndarray:
+    """Periodic waveform with w(0) = 0 and peak slope 1 (peak speed = amplitude * 2 pi f)."""
+    return _raw_waveform(name, phi) / _slope_norm(name)
+
+
+def _smoothstep(u: np.ndarray) -> np.ndarray:
+    u = np.clip(u, 0.0, 1.0)
+    return u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One curriculum entry (its ``index`` is its place in the unshuffled enumeration)."""
+
+    index: int
+    family: str
+    waveform: str
+    joints: tuple[int, ...]
+    speed_scale: float
+    payload_scale: float
+
+
+@dataclass(frozen=True)
+class ScheduledSegment:
+    """A segment as visited in a session: where it starts, where it comes to rest, when."""
+
+    visit: int
+    segment: Segment
+    start_pose: np.ndarray
+    center: np.ndarray
+    t_start: float
+
+
+class Curriculum:
+    """Enumerates the curriculum and serves the session's reference trajectory."""
+
+    def __init__(
+        self,
+        speed_scales: Sequence[float],
+        payload_scales: Sequence[float],
+        nominal_payload_kg: float,
+        base_frequency_hz: float,
+        segment_s: float,
+        blend_s: float,
+        amplitude_rad: Sequence[float],
+        pair_amplitude_factor: float,
+        whole_arm_amplitude_factor: float,
+        center_jitter_rad: Sequence[float],
+        home: Sequence[float],
+        payload_ramp_s: float = 1.0,
+        families: Sequence[str] = FAMILIES,
+        seed: int = 0,
+    ) -> None:
+        if not speed_scales or not payload_scales:
+            raise InputError("curriculum needs at least one speed scale and one payload scale")
+        if segment_s < 2.0 * blend_s:
+            raise InputError(f"segment_s ({segment_s}) must be >= 2 * blend_s ({blend_s})")
+        for name, vec in (
+            ("amplitude_rad", amplitude_rad),
+            ("center_jitter_rad", center_jitter_rad),
+            ("home", home),
+        ):
+            if len(vec) != N_JOINTS:
+                raise InputError(f"curriculum.{name} needs {N_JOINTS} values, got {len(vec)}")
+        self.speed_scales = [float(s) for s in speed_scales]
+        self.payload_scales = [float(p) for p in payload_scales]
+        self.nominal_payload_kg = float(nominal_payload_kg)
+        self.base_frequency_hz = float(base_frequency_hz)
+        self.segment_s = float(segment_s)
+        self.blend_s = float(blend_s)
+        self.amplitude = np.asarray(amplitude_rad, dtype=float)
+        self.pair_factor = float(pair_amplitude_factor)
+        self.whole_factor = float(whole_arm_amplitude_factor)
+        self.jitter = np.asarray(center_jitter_rad, dtype=float)
+        self.home = np.asarray(home, dtype=float)
+        if not 0.0 <= payload_ramp_s <= blend_s:
+            raise InputError(f"payload_ramp_s ({payload_ramp_s}) must be in [0, blend_s]")
+        self.payload_ramp_s = float(payload_ramp_s)
+        unknown = sorted(set(families) - set(FAMILIES))
+        if unknown or not families:
+            raise InputError(f"curriculum.families must be a non-empty subset of {FAMILIES}")
+        self.families = tuple(families)
+        self.seed = int(seed)
+        self.segments = self._enumerate()
+        self._cache: dict[int, ScheduledSegment] = {}
+
+    def _enumerate(self) -> list[Segment]:
+        speeds, payloads = self.speed_scales, self.payload_scales
+        out: list[Segment] = []
+        for joint, speed, payload in itertools.product(range(N_JOINTS), speeds, payloads):
+            out.append(Segment(len(out), "single_joint", "sine", (joint,), speed, payload))
+        pairs = list(itertools.combinations(range(N_JOINTS), 2))
+        for (p, pair), (s, speed) in itertools.product(enumerate(pairs), enumerate(speeds)):
+            payload = payloads[(p + s) % len(payloads)]
+            out.append(Segment(len(out), "joint_pair", "sine", pair, speed, payload))
+        for wave, speed, payload in itertools.product(WAVEFORMS, speeds, payloads):
+            out.append(Segment(len(out), "whole_arm", wave, tuple(range(N_JOINTS)), speed, payload))
+        for task, speed, payload in itertools.product(TASKS, speeds, payloads):
+            out.append(
+                Segment(len(out), "pick_place", task, tuple(range(N_JOINTS)), speed, payload)
+            )
+        return [s for s in out if s.family in self.families]
+
+    def __len__(self) -> int:
+        return len(self.segments)
+
+    def _order(self, pass_index: int) -> np.ndarray:
+        return np.random.default_rng([self.seed, 0, pass_index]).permutation(len(self.segments))
+
+    def scheduled(self, visit: int) -> ScheduledSegment:
+        """The ``visit``-th segment of the session (passes reshuffle; random access is cheap)."""
+        if visit not in self._cache:
+            n = len(self.segments)
+            segment = self.segments[int(self._order(visit // n)[visit % n])]
+            rng = np.random.default_rng([self.seed, 1, visit])
+            center = self.home + rng.uniform(-1.0, 1.0, N_JOINTS) * self.jitter
+            start = self.home if visit == 0 else self.scheduled(visit - 1).center
+            self._cache[visit] = ScheduledSegment(
+                visit, segment, start, center, visit * self.segment_s
+            )
+            self._cache.pop(visit - 2, None)
+        return self._cache[visit]
+
+    def visit_at(self, t: float) -> int:
+        return int(np.floor(t / self.segment_s + 1e-9))
+
+    def payload_kg(self, visit: int) -> float:
+        return self.nominal_payload_kg * self.scheduled(visit).segment.payload_scale
+
+    def waypoints(self, visit: int) -> np.ndarray:
+        """A pick_place segment's poses ``[K, 6]``, from its start to its centre: over the pick,
+        down, up, over the place (a palletising layer's next cell), down, up, centre."""
+        sched = self.scheduled(visit)
+        rng = np.random.default_rng([self.seed, 3, visit])
+        pick = sched.center + rng.uniform(-0.4, 0.4, N_JOINTS) * self.amplitude
+        if sched.segment.waveform == "palletise":  # cells of a 3 x 2 layer, in turn
+            cell = visit % 6
+            place = self.home + np.array([0.5 + 0.2 * (cell % 3), 0.1 * (cell // 3), 0, 0, 0, 0])
+        else:
+            place = sched.center + rng.uniform(-0.4, 0.4, N_JOINTS) * self.amplitude
+        lift = np.asarray(LIFT_RAD)
+        return np.stack(
+            [sched.start_pose, pick + lift, pick, pick + lift, place + lift, place, place + lift,
+             sched.center]
+        )  # fmt: skip
+
+    def _point_to_point(self, visit: int, tau: np.ndarray) -> np.ndarray:
+        """Quintic moves between the waypoints with equal dwells between them (a taught program:
+        each move starts and stops at rest, so the reference stays C2)."""
+        poses = self.waypoints(visit)
+        speed = self.scheduled(visit).segment.speed_scale
+        # a quintic's peak speed is 1.875 x distance / duration
+        span = np.abs(np.diff(poses, axis=0)).max(axis=1)
+        legs = np.maximum(LEG_S, 1.875 * span / JOINT_SPEED) / speed
+        legs *= min(1.0, 0.9 * self.segment_s / legs.sum())  # a program fits its segment
+        dwell = (self.segment_s - legs.sum()) / (len(legs) + 1)
+        out = np.repeat(poses[:1], len(tau), axis=0)
+        t0 = dwell
+        for k, leg in enumerate(legs):
+            u = _smoothstep((tau[:, 0] - t0) / leg)[:, None]
+            out = out + (poses[k + 1] - poses[k]) * u
+            t0 += leg + dwell
+        return out
+
+    def _amplitude(self, segment: Segment) -> np.ndarray:
+        factor = {
+            "single_joint": 1.0,
+            "joint_pair": self.pair_factor,
+            "whole_arm": self.whole_factor,
+            "pick_place": 0.0,  # its motion is its waypoints
+        }[segment.family]
+        amp = np.zeros(N_JOINTS)
+        idx = list(segment.joints)
+        amp[idx] = self.amplitude[idx] * factor
+        return amp
+
+    def _phase(self, segment: Segment) -> np.ndarray:
+        phase = np.zeros(N_JOINTS)
+        if segment.family == "joint_pair":
+            phase[segment.joints[1]] = np.pi / 2
+        elif segment.family == "whole_arm":
+            phase[:] = np.arange(N_JOINTS) * np.pi / 3
+        return phase
+
+    def position(self, visit: int, t: np.ndarray) -> np.ndarray:
+        """Reference link angles ``[len(t), 6]`` at session times ``t`` within one visit."""
+        sched = self.scheduled(visit)
+        seg = sched.segment
+        tau = np.asarray(t, dtype=float)[:, None] - sched.t_start
+        if seg.family == "pick_place":
+            return self._point_to_point(visit, tau)
+        blend = _smoothstep(tau / self.blend_s)
+        envelope = blend * _smoothstep((self.segment_s - tau) / self.blend_s)
+        omega = 2.0 * np.pi * self.base_frequency_hz * seg.speed_scale
+        # Subtracting each joint's value at its phase offset keeps the motion zero at rest, so the
+        # envelope alone shapes the start and the stop.
+        phase = self._phase(seg)
+        shape = waveform(seg.waveform, omega * tau + phase) - waveform(seg.waveform, phase)
+        moving = self._amplitude(seg) * envelope * shape
+        return sched.start_pose + (sched.center - sched.start_pose) * blend + moving
+
+    def reference(
+        self, visit: int, t: np.ndarray, h: float = 1e-3
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity and acceleration ``[len(t), 6]`` by central differences."""
+        t = np.asarray(t, dtype=float)
+        q_minus, q, q_plus = (self.position(visit, t + d) for d in (-h, 0.0, h))
+        return q, (q_plus - q_minus) / (2 * h), (q_plus - 2 * q + q_minus) / (h * h)

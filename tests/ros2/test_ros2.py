@@ -1,0 +1,418 @@
+"""The live ROS 2 bridge over DDS, on loopback only: the bytes on the wire equal the bag's CDR,
+a simulated arm's samples reach the monitor intact, its diagnoses reach /diagnostics, and a bad
+message marks its arm and nothing else. Skipped, with the reason, where cyclonedds is absent."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import json
+import os
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("cyclonedds", reason="the ROS 2 bridge needs cyclonedds: pip install '.[ros2]'")
+
+from robohealth_mj.bags.messages import MessageFactory, typestore
+from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.data.read import read_samples
+from robohealth_mj.ros2.assembly import ArmAssembler
+from robohealth_mj.ros2.bus import Bus, BusConfig
+from robohealth_mj.ros2.idl import IdlStore
+from robohealth_mj.ros2.node import ArmPublisher, MonitorNode, arm_topics, in_partition
+from robohealth_mj.runtime.runtime import ModelRuntime
+
+# One domain per test (a DDS domain id is 0..232), so tests never see each other's traffic.
+_DOMAINS = itertools.count(100 + os.getpid() % 50 * 2)
+
+
+def _bus() -> BusConfig:
+    return BusConfig(domain_id=next(_DOMAINS), interface="127.0.0.1")
+
+
+def test_every_message_s_bytes_equal_the_bag_s_cdr(deployed):
+    """What goes on the wire is what rosbags writes into a bag: one mapping, two transports."""
+    sample = next(iter(read_samples(deployed["heldout"])))
+    topics, store = BagTopics.load(), typestore()
+    reference = MessageFactory(store).sample_messages(sample, topics)
+    live = MessageFactory(IdlStore()).sample_messages(sample, topics)
+    kinds = topics.sample_topics()
+    assert len(live) == len(kinds) == 15  # 14 data topics and the ground truth
+    for (topic, ref), (same, msg) in zip(reference, live, strict=True):
+        assert same == topic
+        assert msg.serialize() == bytes(store.serialize_cdr(ref, kinds[topic])), topic
+
+
+def _feed(assembler: ArmAssembler, messages, order=None, poll_every: int = 1, counts=None):
+    """Messages into the assembler, a poll boundary (``settle``) after every ``poll_every``."""
+    out_samples, problems = [], []
+    items = list(messages)
+    order = list(order if order is not None else range(len(items)))
+    for n, k in enumerate(order, 1):
+        got = [assembler.add(*items[k])]
+        if n % poll_every == 0 or n == len(order):
+            got.append(assembler.settle())
+        for g in got:
+            out_samples += g.samples
+            problems += g.problems
+            if counts is not None:
+                counts["duplicates"] += g.duplicates
+                counts["late"] += g.late
+    return out_samples, problems
+
+
+def test_assembly_is_exact_in_any_topic_order_and_flags_what_goes_wrong(deployed):
+    samples = list(itertools.islice(read_samples(deployed["heldout"]), 6))
+    topics = arm_topics("arm7")
+    factory = MessageFactory(IdlStore())
+    messages = [m for s in samples for m in factory.sample_messages(s, topics)]
+    # stamped topics shuffled within each tick; the (headerless) vibration arrays in order
+    rng = np.random.default_rng(0)
+    per_tick = len(messages) // len(samples)
+    order = []
+    for tick in range(len(samples)):
+        order += list(rng.permutation(np.arange(tick * per_tick, (tick + 1) * per_tick)))
+    got, problems = _feed(ArmAssembler("arm7", topics), messages, order)
+    assert problems == []
+    assert [s.sample_index for s in got] == [s.sample_index for s in samples]
+    for a, b in zip(got, samples, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        assert a.fault == b.fault and a.t == pytest.approx(b.t)
+
+    # a wrong array length, a NaN, a stamp going backwards: flagged, the stream goes on
+    bad = [list(factory.sample_messages(s, topics)) for s in samples]
+    bad[1][0][1].position = bad[1][0][1].position[:5]
+    bad[2][2][1].linear_acceleration.x = float("nan")
+    before = factory.sample_messages(samples[0], topics)[0]  # a stamp before every tick
+    before[1].header.stamp.sec -= 10
+    flat = [m for tick in bad for m in tick] + [before]
+    got, problems = _feed(ArmAssembler("arm7", topics), flat)
+    assert [s.sample_index for s in got] == [samples[k].sample_index for k in (0, 3, 4, 5)]
+    assert any("'position': 5 values" in p for p in problems)
+    assert any("NaN or Inf in x[shoulder_pan_sensor].acc_x" in p for p in problems)
+    assert problems[-1].endswith("stamps went backwards") and len(problems) == 3
+
+    # a message lost at one stamp: flagged once newer stamps have completed, the rest go on
+    more = list(itertools.islice(read_samples(deployed["heldout"]), 14))
+    ticks = [list(factory.sample_messages(s, topics)) for s in more]
+    assert ticks[2][3][0] == "/arm7/sensors/shoulder_pan/vibration"
+    del ticks[2][3]  # a headerless array: paired by the stamp its layout carries
+    got, problems = _feed(ArmAssembler("arm7", topics), [m for t in ticks for m in t])
+    assert problems == [
+        f"topic '/arm7/sensors/shoulder_pan/vibration' at stamp {more[2].t:.6f} s: message "
+        "missing (1 topics)"
+    ]
+    np.testing.assert_array_equal(got[2].x, more[3].x)  # the next tick's data stay its own
+    assert [s.sample_index for s in got[:2]] == [0, 1] and got[2].sample_index == 3
+
+
+def test_a_backlog_duplicates_and_late_messages_are_told_apart_from_bad_input(deployed):
+    """A monitor takes its topics one after another: after a stall, one poll takes many ticks
+    of the stamped topics before the arrays of the same ticks. Every tick is still assembled. A
+    repeated identical message is a duplicate, one for a tick already reported missing is late,
+    and neither is bad input; a different message at a used stamp is."""
+    samples = list(itertools.islice(read_samples(deployed["heldout"]), 24))
+    topics = arm_topics("arm7")
+    factory = MessageFactory(IdlStore())
+    ticks = [list(factory.sample_messages(s, topics)) for s in samples]
+    vibration = {t for t, _ in ticks[0] if t.endswith("/vibration")}
+    backlog = [m for t in ticks for m in t if m[0] not in vibration]
+    backlog += [m for t in ticks for m in t if m[0] in vibration]
+    counts = {"duplicates": 0, "late": 0}
+    assembler = ArmAssembler("arm7", topics)
+    got, problems = _feed(assembler, backlog, poll_every=len(backlog), counts=counts)
+    assert problems == [] and len(got) == 24
+    assert [s.sample_index for s in got] == [s.sample_index for s in samples]
+
+    again = factory.sample_messages(samples[20], topics)  # re-delivered: counted, not bad
+    changed = factory.sample_messages(samples[21], topics)[0]
+    changed[1].position = [p + 1.0 for p in changed[1].position]
+    _, problems = _feed(assembler, [*again, changed], counts=counts)
+    assert counts == {"duplicates": 15, "late": 0}
+    assert problems == [
+        f"topic '/arm7/joint_states': a second, different message at stamp {samples[21].t:.6f} s"
+    ]
+
+    # one array held back past the late limit: the tick is missing once, the array then late
+    more = list(itertools.islice(read_samples(deployed["heldout"]), 16))
+    ticks = [list(factory.sample_messages(s, topics)) for s in more]
+    held = ticks[2].pop(3)
+    counts = {"duplicates": 0, "late": 0}
+    stream = [m for t in ticks for m in t] + [held]
+    got, problems = _feed(ArmAssembler("arm7", topics), stream, counts=counts)
+    assert len(got) == 15 and len(problems) == 1 and "message missing" in problems[0]
+    assert counts == {"duplicates": 0, "late": 1}
+
+
+def test_a_fleet_is_split_by_namespace_hash_with_every_arm_in_one_share():
+    arms = [f"arm{k}" for k in range(40)]
+    shares = [[a for a in arms if in_partition(a, f"{k}/3")] for k in range(3)]
+    assert sorted(a for share in shares for a in share) == sorted(arms) and all(shares)
+    with pytest.raises(ValueError, match="partition"):
+        in_partition("arm1", "3/3")
+
+
+def _spin(node: MonitorNode, until, timeout_s: float = 10.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline and not until():
+        node.poll()
+        time.sleep(0.005)
+
+
+def test_simulated_arms_on_loopback_are_diagnosed_and_reported_on_diagnostics(deployed):
+    """Two arms publish over DDS; the monitor diagnoses both exactly as the replay does, a bad
+    message marks its arm WARN without touching the other, and a silent arm goes STALE."""
+    from robohealth_mj.ros2.idl import DiagnosticArray
+
+    config = _bus()
+    robot, monitor_bus, listener = Bus(config), Bus(config), Bus(config)
+    samples = list(itertools.islice(read_samples(deployed["heldout"]), 40))
+    runtime = ModelRuntime(deployed["structural_onnx"])
+    node = MonitorNode(monitor_bus, runtime, ["arm1", "arm2"], stale_s=0.5, keep_diagnoses=True)
+    diagnostics = listener.reader("/diagnostics", DiagnosticArray)
+    arms = {a: ArmPublisher(robot, a) for a in ("arm1", "arm2")}
+    time.sleep(0.5)  # discovery on loopback
+    for k, s in enumerate(samples):
+        for arm, pub in arms.items():
+            if arm == "arm2" and k == 20:  # one malformed tick on arm2 only
+                msgs = pub.factory.sample_messages(s, pub.topics)
+                msgs[0][1].effort = msgs[0][1].effort[:2]
+                for topic, msg in msgs:
+                    pub.writers[topic].write(msg)
+            else:
+                pub.publish(s)
+        node.poll()
+    _spin(node, lambda: node.arms["arm1"].samples >= 40 and node.arms["arm2"].samples >= 39)
+    assert node.arms["arm1"].samples == 40 and node.arms["arm2"].samples == 39
+    assert node.arms["arm2"].problems == 1 and node.arms["arm1"].problems == 0
+
+    reference = ModelRuntime(deployed["structural_onnx"])
+    expected = [reference.process("arm1", s) for s in samples]
+    live = node.arms["arm1"].diagnoses
+    assert [d.fault_class for d in live] == [d.fault_class for d in expected]
+    assert [d.alarm for d in live] == [d.alarm for d in expected]
+
+    array = node.publish_diagnostics(samples[-1].t)
+    by_arm = {s.hardware_id: s for s in array.status}
+    assert by_arm["arm2"].level == 1 and "'effort': 2 values" in by_arm["arm2"].message
+    assert by_arm["arm1"].level in (0, 2) and "bad input" not in by_arm["arm1"].message
+    seen = []
+    _spin(node, lambda: seen.extend(diagnostics.take(N=10)) or seen, timeout_s=5)
+    assert seen and {s.hardware_id for s in seen[-1].status} == {"arm1", "arm2"}
+    time.sleep(0.6)
+    stale = node.publish_diagnostics(samples[-1].t)
+    assert all(s.level == 3 and "no sample for" in s.message for s in stale.status)
+    for bus in (robot, monitor_bus, listener):
+        bus.close()
+
+
+def test_two_monitor_processes_split_four_arms_and_stop_cleanly_on_sigterm(deployed, tmp_path):
+    """The command line end to end: a simulated robot process replays four arms; two monitor
+    processes share them by hash partition (no arm diagnosed twice, none left out, every sample
+    diagnosed) and end cleanly on SIGTERM with their counts."""
+    import signal
+    import subprocess
+    import sys
+
+    lines = deployed["heldout"].read_text().splitlines(keepends=True)[:100]
+    short = tmp_path / "short.jsonl"
+    short.write_text("".join(lines))
+    # history for 2.5 s of ticks at speed 4: a stalled monitor catches up with nothing lost
+    common = [f"ros2.domain_id={next(_DOMAINS)}", "ros2.interface=127.0.0.1", "ros2.count=4",
+              "ros2.depth=200"]  # fmt: skip
+    monitors = [
+        subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "robohealth_mj.monitor",
+                f"model={deployed['structural_onnx']}",
+                "source=ros2",
+                "duration_s=0",
+                *common,
+                f"ros2.partition={k}/2",
+                "evaluate=true",
+                "ros2.reliable_subscriptions=true",  # every sample is asked for: no loss
+                f"out={tmp_path / f'ros2_{k}.json'}",
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        for k in range(2)
+    ]
+    try:
+        for m in monitors:  # each says it is listening once its participant exists
+            assert m.stdout.readline().startswith("ros2 monitor:")
+        robot = subprocess.Popen(
+            [sys.executable, "-m", "robohealth_mj.robot", "source=replay", f"file={short}",
+             "speed=4", "discovery_s=2", *common],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        )  # fmt: skip
+        # A busy machine: the monitors lose the processor for 0.3 s in every 1.2 s while the
+        # robot runs (its 100 ticks take 1.25 s), so a poll finds a backlog of many ticks on
+        # every topic; within the readers' history, so every sample must still be diagnosed.
+        deadline = time.monotonic() + 120
+        while robot.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.9)
+            for m in monitors:
+                m.send_signal(signal.SIGSTOP)
+            time.sleep(0.3)
+            for m in monitors:
+                m.send_signal(signal.SIGCONT)
+        robot_out = robot.communicate(timeout=10)[0]
+        assert robot.returncode == 0, robot_out
+        assert "published 100 ticks" in robot_out
+        time.sleep(2)
+        for m in monitors:
+            m.send_signal(signal.SIGTERM)
+        outputs = [m.communicate(timeout=60)[0] for m in monitors]
+    finally:
+        for m in monitors:
+            m.kill() if m.poll() is None else None
+    assert [m.returncode for m in monitors] == [0, 0], outputs
+    counts = [
+        {line.split(":")[0]: line for line in out.splitlines() if " samples diagnosed" in line}
+        for out in outputs
+    ]
+    assert set(counts[0]).isdisjoint(counts[1])
+    assert set(counts[0]) | set(counts[1]) == {"arm1", "arm2", "arm3", "arm4"}
+    for share in counts:
+        for line in share.values():
+            assert ": 100 samples diagnosed, 0 bad inputs, 0 late" in line, line
+    # the on-line evaluation over DDS is the replay's, arm by arm
+    from robohealth_mj.monitor import main as monitor_main
+
+    replay = monitor_main([f"model={deployed['structural_onnx']}", "source=replay",
+                           f"file={short}", "evaluate=true", "quiet=true",
+                           f"out={tmp_path / 'replay.json'}"])  # fmt: skip
+    live = {}
+    for k in range(2):
+        assert (tmp_path / f"ros2_{k}.json").is_file(), outputs[k]
+        live |= json.loads((tmp_path / f"ros2_{k}.json").read_text())["arms"]
+    assert set(live) == {"arm1", "arm2", "arm3", "arm4"}
+    for result in live.values():
+        for key in ("online_accuracy", "localisation_accuracy", "alarms", "false_alarm_rate"):
+            assert result[key] == replay[key], key
+
+
+def test_a_topic_of_the_wrong_type_and_a_robot_that_goes_silent_and_returns_mark_their_arm(
+    deployed,
+):
+    """A writer of another message type on an arm's topic, an arm that stops and comes back:
+    each is that arm's status on /diagnostics (WARN, STALE, then OK again), the other arm's
+    diagnoses go on."""
+    from robohealth_mj.ros2.idl import Float64MultiArray
+
+    config = _bus()
+    robot, monitor_bus, stranger = Bus(config), Bus(config), Bus(config)
+    samples = list(itertools.islice(read_samples(deployed["heldout"]), 30))
+    node = MonitorNode(monitor_bus, ModelRuntime(deployed["structural_onnx"]), ["arm1", "arm2"],
+                       stale_s=0.4)  # fmt: skip
+    arms = {a: ArmPublisher(robot, a) for a in ("arm1", "arm2")}
+    stranger.writer("/arm2/joint_states", Float64MultiArray)  # the wrong type on arm2's topic
+    time.sleep(0.5)
+    for s in samples[:10]:
+        for pub in arms.values():
+            pub.publish(s)
+    _spin(node, lambda: node.arms["arm1"].samples >= 10 and node.arms["arm2"].samples >= 10)
+    status = {s.hardware_id: s for s in node.publish_diagnostics(samples[9].t).status}
+    assert (
+        status["arm2"].level == 1 and "cannot match a JointState reader" in status["arm2"].message
+    )
+    assert "bad input" not in status["arm1"].message
+    for s in samples[10:20]:  # arm2 goes silent
+        arms["arm1"].publish(s)
+    _spin(node, lambda: node.arms["arm1"].samples >= 20)
+    time.sleep(0.5)
+    node.poll()
+    arms["arm1"].publish(samples[20])
+    _spin(node, lambda: node.arms["arm1"].samples >= 21)
+    status = {s.hardware_id: s for s in node.publish_diagnostics(samples[20].t).status}
+    assert status["arm2"].level == 3 and status["arm1"].level != 3
+    for s in samples[21:30]:  # arm2 is back: its next stamps follow on
+        arms["arm2"].publish(s)
+    _spin(node, lambda: node.arms["arm2"].samples >= 19)
+    status = {s.hardware_id: s for s in node.publish_diagnostics(samples[29].t).status}
+    assert status["arm2"].level != 3 and node.arms["arm2"].samples == 19
+    for bus in (robot, monitor_bus, stranger):
+        bus.close()
+
+
+def test_the_aggregated_layout_carries_each_snapshot_whole_over_the_bus(deployed):
+    """One array per arm per tick (and the truth): the samples arrive exactly, the diagnoses are
+    the per-sensor layout's."""
+    config = _bus()
+    robot, monitor_bus = Bus(config), Bus(config)
+    samples = list(itertools.islice(read_samples(deployed["heldout"]), 8))
+    node = MonitorNode(monitor_bus, ModelRuntime(deployed["structural_onnx"]), ["arm1"],
+                       layout="aggregated", keep_diagnoses=True)  # fmt: skip
+    pub = ArmPublisher(robot, "arm1", layout="aggregated")
+    assert list(pub.writers) == ["/arm1/graph_sample", "/arm1/fault_state"]
+    got = []
+    node.on_diagnosis = lambda arm, sample, d: got.append(sample)
+    time.sleep(0.5)
+    for s in samples:
+        pub.publish(s)
+    _spin(node, lambda: len(got) >= len(samples))
+    assert [s.sample_index for s in got] == [s.sample_index for s in samples]
+    for a, b in zip(got, samples, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        assert a.fault == b.fault
+    reference = ModelRuntime(deployed["structural_onnx"])
+    expected = [reference.process("arm1", s) for s in samples]
+    live = node.arms["arm1"].diagnoses
+    assert [d.fault_class for d in live] == [d.fault_class for d in expected]
+    for bus in (robot, monitor_bus):
+        bus.close()
+
+
+def test_a_stock_arm_publishing_its_joint_topics_alone_is_diagnosed_by_a_stock_model(
+    stock_deployed,
+):
+    """``ros2.layout=joints``: a stock arm's own topics (joint state, tracking error; no
+    ground truth, no sensor package). The samples arrive with the joint channels exact and the
+    sensor channels zero, numbered by arrival, and the stock model decides them as on replay."""
+    config = dataclasses.replace(_bus(), depth=64)  # the whole burst kept
+    robot, monitor_bus = Bus(config), Bus(config)
+    samples = list(itertools.islice(read_samples(stock_deployed["heldout"]), 40))
+    node = MonitorNode(monitor_bus, ModelRuntime(stock_deployed["onnx"]), ["cobot"],
+                       layout="joints", require_truth=False, keep_diagnoses=True)  # fmt: skip
+    pub = ArmPublisher(robot, "cobot", layout="joints")
+    assert list(pub.writers) == ["/cobot/joint_states", "/cobot/joint_tracking_error",
+                                 "/cobot/fault_state"]  # fmt: skip
+    got = []
+    node.on_diagnosis = lambda arm, sample, d: got.append(sample)
+    deadline = time.monotonic() + 10.0  # both ends of both data topics matched: no tick lost
+    writers = list(pub.writers.values())[:2]
+    readers = [r for _, _, r in node.arms["cobot"].readers]
+    while time.monotonic() < deadline and not (
+        all(w.get_matched_subscriptions() for w in writers)
+        and all(r.get_matched_publications() for r in readers)
+    ):
+        time.sleep(0.05)
+    for s in samples:
+        pub.publish(s)
+    _spin(node, lambda: len(got) >= len(samples))
+    print(
+        "PROBLEMS",
+        node.arms["cobot"].problems,
+        node.arms["cobot"].last_problem,
+        node.arms["cobot"].problem,
+    )
+    assert [s.sample_index for s in got] == list(range(len(samples)))
+    state = slice(2, 7)
+    for a, b in zip(got, samples, strict=True):
+        np.testing.assert_array_equal(a.x[:, state], b.x[:, state])
+        assert not a.x[:, 7:].any() and a.fault.fault_class == "none"
+    reference = ModelRuntime(stock_deployed["onnx"])
+    expected = [reference.process("cobot", s) for s in samples]
+    live = node.arms["cobot"].diagnoses
+    assert [d.fault_class for d in live] == [d.fault_class for d in expected]
+    assert sum(d.class_probabilities != {} for d in live) > 20  # decided, not warming up
+    for a, b in zip(live, expected, strict=True):
+        assert a.class_probabilities == pytest.approx(b.class_probabilities, abs=1e-5)
+    for bus in (robot, monitor_bus):
+        bus.close()
