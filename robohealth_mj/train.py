@@ -20,31 +20,7 @@ from omegaconf import DictConfig
 from robohealth_mj.common.config import register_resolvers
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.resources import HYDRA_CONF
-from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
-from robohealth_mj.learn.trainer import CHECKPOINT, finished_on_current_data, train_run
-
-
-def run(cfg: DictConfig, out_dir: Path) -> dict:
-    if cfg.skip_done and finished_on_current_data(cfg, out_dir):
-        print(f"skip {out_dir}: evaluation on the current data exists")
-        return {"skipped": True}
-    summary = train_run(cfg, out_dir)
-    results = {"train": summary}
-    for name, data in (cfg.data.evaluate or {}).items():
-        if data:
-            result = evaluate_checkpoint(out_dir / CHECKPOINT, data, cfg.trainer.device)
-            write_evaluation(result, out_dir / f"eval_{name}")
-            results[name] = result
-    m = results.get("heldout", {}).get("metrics", summary["test"])
-    print(
-        f"{cfg.variant} W={cfg.window} seed={cfg.seed} [{summary['graph']}]: "
-        f"accuracy {m.get('accuracy', float('nan')):.3f}  "
-        f"localisation {m.get('localisation_accuracy', float('nan')):.3f}  "
-        f"macro-F1 {m.get('macro_f1', float('nan')):.3f}  -> {out_dir}",
-        flush=True,
-    )
-    return results
-
+from robohealth_mj.learn.run import train_and_evaluate
 
 register_resolvers()
 
@@ -52,7 +28,7 @@ register_resolvers()
 @hydra.main(config_path=HYDRA_CONF, config_name="train", version_base="1.3")
 def main(cfg: DictConfig) -> None:
     with one_line_errors("train"):
-        run(cfg, Path(cfg.out_dir or HydraConfig.get().runtime.output_dir))
+        train_and_evaluate(cfg, Path(cfg.out_dir or HydraConfig.get().runtime.output_dir))
 
 
 if __name__ == "__main__":

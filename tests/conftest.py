@@ -149,7 +149,7 @@ def _tiny_train_config(corpus: Path, *overrides: str):
 
 def _train_and_export(corpus: Path, root: Path) -> dict:
     from robohealth_mj.deploy.export import export_checkpoint
-    from robohealth_mj.train import run
+    from robohealth_mj.learn.run import train_and_evaluate as run
 
     paths = {"root": str(corpus), "heldout": str(corpus / "heldout" / "graphs.jsonl")}
     models = {  # structural: a model that decides; harness: the headline variant, barely trained
@@ -181,7 +181,7 @@ def deployed(tmp_path_factory, learnable_corpus) -> dict[str, Path]:
 
 def _train_stock(corpus: Path, root: Path) -> dict:
     from robohealth_mj.deploy.export import export_checkpoint
-    from robohealth_mj.train import run
+    from robohealth_mj.learn.run import train_and_evaluate as run
 
     cfg = _tiny_train_config(
         corpus, "trainer.epochs=1", "sensing=stock", "variant=stgnn_fixed", "model.hidden=8"

@@ -10,6 +10,7 @@ import importlib.resources
 import importlib.util
 import json
 import os
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -94,9 +95,13 @@ def test_the_monitor_runs_an_exported_model_without_torch(deployed, tmp_path):
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory) -> Path:
     """The project's wheel, built from this checkout with the setuptools already installed."""
-    out = tmp_path_factory.mktemp("wheel")
+    out, source = tmp_path_factory.mktemp("wheel"), tmp_path_factory.mktemp("source")
+    for name in ("pyproject.toml", "setup.py", "README.md"):  # a build writes beside its source:
+        shutil.copy2(REPO / name, source / name)  # build from a copy, never into the checkout
+    for name in ("robohealth_mj", "conf", "assets"):
+        shutil.copytree(REPO / name, source / name, ignore=shutil.ignore_patterns("__pycache__"))
     done = subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", str(REPO), "--no-deps", "--no-build-isolation",
+        [sys.executable, "-m", "pip", "wheel", str(source), "--no-deps", "--no-build-isolation",
          "--quiet", "-w", str(out)],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
@@ -178,3 +183,56 @@ def test_a_research_script_imports_only_what_exists(script):
             assert hasattr(loaded, name) or importlib.util.find_spec(f"{module}.{name}"), (
                 f"{where}: {module} has no {name}"
             )
+
+
+# The layers, lowest first: a module may import from its own layer and those below it.
+LAYERS = (
+    ("schema", "common"),
+    ("sim",),
+    ("faults",),
+    ("data", "logs", "bags"),  # recordings on disk, controller logs and bags: one layer of readers
+    ("recording",),
+    ("models",),
+    ("learn",),
+    ("runtime",),  # torch-free streaming
+    ("deploy", "ros2"),  # offline deployment tools; the live bus
+    ("reporting", "benchmarks"),
+    ("<entry point>",),
+)
+PACKAGE = REPO / "robohealth_mj"
+
+
+def _layer_of(parts: tuple[str, ...]) -> int:
+    """The layer of ``robohealth_mj.<parts>``: a subpackage's, or the schema's, or an entry
+    point's (every other module at the package root)."""
+    name = parts[0] if parts else "<entry point>"
+    if (PACKAGE / name).is_dir() or name == "schema":
+        return next(k for k, layer in enumerate(LAYERS) if name in layer)
+    return len(LAYERS) - 1
+
+
+def test_layers_point_one_way():
+    """sim -> data -> recording -> models/learn -> runtime -> deploy -> entry points: no module
+    imports from a layer above its own (a lazy import inside a function counts too)."""
+    upward = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(PACKAGE).with_suffix("").parts
+        if parts[0] in ("conf", "assets") or parts == ("__init__",):
+            continue
+        own = _layer_of(parts if len(parts) > 1 else (parts[0],))
+        for module, _, line in _imports(path):
+            if not module.startswith("robohealth_mj."):
+                continue
+            target = _layer_of(tuple(module.split(".")[1:]))
+            if target > own:
+                upward.append(f"robohealth_mj/{'/'.join(parts)}.py:{line} imports {module}")
+    assert upward == []
+
+
+def test_the_package_root_holds_the_entry_points_and_the_schema_only():
+    library = [
+        p.name
+        for p in PACKAGE.glob("*.py")
+        if p.stem not in ("__init__", "schema") and '__name__ == "__main__"' not in p.read_text()
+    ]
+    assert library == []

@@ -87,7 +87,7 @@ def bench_headline(overrides: list[str]) -> dict:
     from pathlib import Path
 
     from robohealth_mj.common.config import compose_config
-    from robohealth_mj.train import run
+    from robohealth_mj.learn.run import train_and_evaluate as run
 
     cfg = compose_config("train", ["trainer.progress=false", "skip_done=false", *overrides])
     with tempfile.TemporaryDirectory() as tmp:

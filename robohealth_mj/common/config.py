@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 from hydra import compose, initialize_config_dir
 from hydra.core.global_hydra import GlobalHydra
@@ -11,10 +12,22 @@ from omegaconf import DictConfig, OmegaConf
 from robohealth_mj.common.resources import conf_dir
 
 
+def placement_name(graph_cfg: Any) -> str:
+    """A short name for a graph config's placement, for run directories and report rows:
+    ``C0`` (the default harness or no coupling at all), ``seed7_m6`` (drawn), ``file`` or
+    ``given``."""
+    get = graph_cfg.get if hasattr(graph_cfg, "get") else lambda k, d=None: d
+    if get("coupling_seed") is not None:
+        return f"seed{int(get('coupling_seed'))}_m{int(get('coupling_sensors', 4))}"
+    if get("coupling_file"):
+        return "file"
+    if get("coupling") is not None:
+        return "given"
+    return "C0"
+
+
 def register_resolvers() -> None:
     """``${placement:${graph}}`` in the configs (run directories): see ``placement_name``."""
-    from robohealth_mj.data.graphs import placement_name
-
     OmegaConf.register_new_resolver("placement", placement_name, replace=True)
 
 

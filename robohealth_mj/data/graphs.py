@@ -8,7 +8,6 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -205,20 +204,6 @@ def harness_graph(
     adj[:j, j:] = adj[j:, :j] = 1.0
     names = schema.JOINT_NAMES + tuple(f"harness_sensor_{k}" for k in range(m))
     return GraphSpec("harness", names, adj, j, c)
-
-
-def placement_name(graph_cfg: Any) -> str:
-    """A short name for a graph config's placement, for run directories and report rows:
-    ``C0`` (the default harness or no coupling at all), ``seed7_m6`` (drawn), ``file`` or
-    ``given``."""
-    get = graph_cfg.get if hasattr(graph_cfg, "get") else lambda k, d=None: d
-    if get("coupling_seed") is not None:
-        return f"seed{int(get('coupling_seed'))}_m{int(get('coupling_sensors', 4))}"
-    if get("coupling_file"):
-        return "file"
-    if get("coupling") is not None:
-        return "given"
-    return "C0"
 
 
 def coupling_correlation(learned: np.ndarray, truth: np.ndarray) -> float:

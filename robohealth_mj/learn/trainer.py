@@ -21,9 +21,10 @@ from tqdm import tqdm
 
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.config import placement_name
 from robohealth_mj.common.version import code_version
 from robohealth_mj.data.arrays import expand_paths, load_recordings
-from robohealth_mj.data.graphs import GraphSpec, coupling_correlation, placement_name
+from robohealth_mj.data.graphs import GraphSpec, coupling_correlation
 from robohealth_mj.data.windows import make_windows, normalisation, run_aware_split
 from robohealth_mj.learn.checkpoint import save_checkpoint
 from robohealth_mj.learn.data import WindowTensors

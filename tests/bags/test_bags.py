@@ -330,7 +330,7 @@ def test_bag_plot_draws_truth_and_alarms_on_one_timeline(diagnosed, tmp_path):
 
 def test_training_on_bags_equals_training_on_their_jsonl(deployed, bag, tmp_path):
     from robohealth_mj.common.config import compose_config
-    from robohealth_mj.train import run
+    from robohealth_mj.learn.run import train_and_evaluate as run
 
     names = ("train_1", "train_2", "train_3")
     bags = [tmp_path / f"{name}_bag" for name in names]

@@ -59,7 +59,7 @@ def test_a_retrofit_model_never_reads_the_channels_its_arm_lacks(tiny_corpus, tm
     from robohealth_mj.data.arrays import load_recordings
     from robohealth_mj.deploy.export import export_checkpoint, read_metadata
     from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
-    from robohealth_mj.train import run
+    from robohealth_mj.learn.run import train_and_evaluate as run
 
     cfg = compose_config(
         "train",

@@ -193,7 +193,7 @@ def test_a_model_that_reads_no_residual_gets_no_settling_table(tiny_corpus, heal
     """A retrofit model reads no tracking error or torque residual on its joints, so how long
     their baseline took to settle says nothing about it: commissioning says so instead of
     printing a table (the stock model above, which reads them, gets the table)."""
-    from robohealth_mj.train import run
+    from robohealth_mj.learn.run import train_and_evaluate as run
 
     cfg = compose_config("train", [
         f"data.train=[{tiny_corpus}/train_*]", "data.evaluate=null", "trainer.progress=false",

@@ -30,10 +30,10 @@ from robohealth_mj.learn.placements import (
     healthy_sensor_statistics,
     mixed_statistics,
 )
+from robohealth_mj.learn.run import train_and_evaluate as run
 from robohealth_mj.models.heads import AnomalyResidualHead
 from robohealth_mj.recording.recorder import record_session
 from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
-from robohealth_mj.train import run
 
 pytestmark = pytest.mark.slow  # every test here trains a model
 

@@ -27,8 +27,8 @@ from robohealth_mj.learn.checkpoint import (
     model_from_checkpoint,
 )
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
+from robohealth_mj.learn.run import train_and_evaluate as run
 from robohealth_mj.recording.recorder import GRAPHS_FILE
-from robohealth_mj.train import run
 
 pytestmark = pytest.mark.slow  # every test here trains a model
 

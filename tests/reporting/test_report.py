@@ -105,9 +105,8 @@ def test_a_tiny_campaign_goes_through_the_report_into_every_table(tiny_corpus, t
     """Two variants x two seeds (Table 6), a second window (Table 7), the harness with the
     retrofit profile and sign-pinned scores (Table 8), the severity head, and the cost: real
     training runs in the campaign's directory layout, and the tables hold their numbers."""
-    from robohealth_mj.common.config import compose_config
-    from robohealth_mj.data.graphs import placement_name
-    from robohealth_mj.train import run
+    from robohealth_mj.common.config import compose_config, placement_name
+    from robohealth_mj.learn.run import train_and_evaluate as run
 
     def train(*overrides: str) -> dict:
         cfg = compose_config(

@@ -1,30 +1,18 @@
-"""``python -m robohealth_mj.train``: train one variant, then evaluate it on the held-out sets.
-
-    python -m robohealth_mj.train variant=anomaly_residual seed=42 window=32
-    python -m robohealth_mj.train variant=anomaly_residual graph=harness
-    python -m robohealth_mj.train -m variant=mlp,stgnn_fixed seed=42,43,44    # a sweep
-    python -m robohealth_mj.train -m +experiment=thesis_matrix                # the campaign
-
-A run whose held-out evaluation already exists, made on the data the config names now, is
-skipped, so a killed sweep can be relaunched (a re-recorded corpus trains again).
-"""
+"""One run of a campaign: train, then evaluate on every held-out set the config names."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import hydra
-from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
-from robohealth_mj.common.config import register_resolvers
-from robohealth_mj.common.errors import one_line_errors
-from robohealth_mj.common.resources import HYDRA_CONF
 from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 from robohealth_mj.learn.trainer import CHECKPOINT, finished_on_current_data, train_run
 
 
-def run(cfg: DictConfig, out_dir: Path) -> dict:
+def train_and_evaluate(cfg: DictConfig, out_dir: Path) -> dict:
+    """Train one run (or skip it when its evaluation on the current data exists), then evaluate
+    the best checkpoint on each of ``cfg.data.evaluate``; prints the one-line result."""
     if cfg.skip_done and finished_on_current_data(cfg, out_dir):
         print(f"skip {out_dir}: evaluation on the current data exists")
         return {"skipped": True}
@@ -44,16 +32,3 @@ def run(cfg: DictConfig, out_dir: Path) -> dict:
         flush=True,
     )
     return results
-
-
-register_resolvers()
-
-
-@hydra.main(config_path=HYDRA_CONF, config_name="train", version_base="1.3")
-def main(cfg: DictConfig) -> None:
-    with one_line_errors("train"):
-        run(cfg, Path(cfg.out_dir or HydraConfig.get().runtime.output_dir))
-
-
-if __name__ == "__main__":
-    main()

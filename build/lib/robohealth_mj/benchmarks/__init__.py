@@ -1,1 +1,0 @@
-"""Throughput benchmarks behind ``python -m robohealth_mj.bench`` (measurements, not tests)."""

@@ -1,1 +1,0 @@
-"""Recordings on disk: the JSONL interchange format and its readers."""

@@ -1,1 +1,0 @@
-"""Training and evaluation: tensors on the device, losses, metrics, checkpoints."""
