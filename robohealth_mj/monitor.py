@@ -15,40 +15,16 @@ detection latency to class and joint, per fault class and severity.
 from __future__ import annotations
 
 import sys
-import time
-from contextlib import ExitStack
-from datetime import datetime
-from pathlib import Path
 
 from omegaconf import DictConfig
 
-from robohealth_mj.bags import is_bag
-from robohealth_mj.bags.topics import BagTopics
-from robohealth_mj.bags.writer import BagWriter
-from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.common.config import load_cli_config
 from robohealth_mj.common.errors import InputError, one_line_errors
-from robohealth_mj.data.read import recording_sensing
-from robohealth_mj.data.sensing import refuse_missing_channels
-from robohealth_mj.reporting.online import online_markdown
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
-from robohealth_mj.runtime.fleet import freeze_startup_heap
 from robohealth_mj.runtime.metadata import read_metadata
-from robohealth_mj.runtime.online_eval import OnlineEvaluator, joint_activity
-from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
-from robohealth_mj.runtime.sources import replay_stream, sim_stream
-from robohealth_mj.schema import GraphSample
-
-
-def describe(d: HealthDiagnosis) -> str:
-    if not d.valid:
-        return f"INVALID ({d.reason})"
-    if d.fault_class is None:
-        return f"no decision ({d.reason})"
-    if not d.fault_present:
-        return f"healthy (p={d.confidence:.2f})"
-    return f"{d.fault_class} @ {d.localised_joint} (p={d.confidence:.2f})"
+from robohealth_mj.runtime.monitor import monitor_stream, refuse_lacking_data
+from robohealth_mj.runtime.runtime import ModelRuntime
 
 
 def load_config(argv: list[str]) -> DictConfig:
@@ -75,140 +51,20 @@ def _policy(key: str, kind: type, cfg: DictConfig):
             raise InputError(f"conf/monitor.yaml {key}: {exc}") from None
 
 
-def _refuse_lacking_data(model: str, data_sensing: str, source: str) -> None:
-    """One line when the data lacks channels the exported model reads."""
-    refuse_missing_channels(read_metadata(model).get("sensing", "full"), data_sensing, source)
-
-
 def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> dict | None:
-    """Run the source through the runtime; with ``evaluate``, the on-line figures. Healthy ticks
-    count as settled once the window, the evidence and the alarm have had time to let a fault
-    go (``settle``)."""
     if cfg.model:
         read_metadata(cfg.model)  # a model named but unusable is the user's to fix
     runtime = ModelRuntime(
         cfg.model, threads=cfg.threads, alarm=policy, incremental=cfg.incremental,
         evidence=evidence,
     )  # fmt: skip
-    if cfg.source == "ros2":
-        if cfg.model and cfg.ros2.layout == "joints":  # a stock arm's topics: joint channels only
-            _refuse_lacking_data(cfg.model, "stock", "ros2.layout=joints")
-        return _monitor_ros2(cfg, runtime, policy, evidence)
-    if cfg.source == "sim":
-        stream = sim_stream(list(cfg.sim_overrides), cfg.duration_s)
-    elif cfg.source == "replay":
-        if not cfg.file or not (Path(cfg.file).is_file() or is_bag(cfg.file)):
-            raise FileNotFoundError(
-                f"source=replay needs file=PATH to a graphs.jsonl, a bag directory or a "
-                f"controller log (.csv, .parquet) (got {cfg.file})"
-            )
-        if cfg.model:
-            _refuse_lacking_data(cfg.model, recording_sensing(cfg.file), cfg.file)
-        stream = replay_stream(cfg.file)
-    else:
-        raise InputError(f"source must be sim, replay or ros2, got {cfg.source!r}")
-    freeze_startup_heap()
-    settle = runtime.window + policy.clear_after + evidence.clearing_ticks
-    evaluator = OnlineEvaluator(settle_ticks=settle) if cfg.evaluate else None
-    last, started, t0 = None, time.perf_counter(), None
-    with ExitStack() as stack:
-        bag = stack.enter_context(BagWriter(cfg.bag_out)) if cfg.bag_out else None
-        for t, sample, truth in stream:
-            if cfg.speed and t0 is not None:
-                delay = (t - t0) / cfg.speed - (time.perf_counter() - started)
-                if delay > 0:
-                    time.sleep(delay)
-            t0 = t if t0 is None else t0
-            d = runtime.process(cfg.stream_id, sample)
-            if bag is not None and isinstance(sample, GraphSample):
-                bag.write_sample(sample)
-                bag.write_diagnosis(d, runtime.fleet.classes, runtime.fleet.joints)
-            if evaluator is not None and truth is not None:
-                activity = joint_activity(sample.x) if isinstance(sample, GraphSample) else ()
-                evaluator.update(truth, d, *activity)
-            if not cfg.quiet:
-                last = _print(cfg.stream_id, t, d, truth, last)
-    if cfg.bag_out:
-        print(f"replayed topics and {BagTopics.load().health_diagnosis} -> {cfg.bag_out}")
-    if evaluator is None:
-        return None
-    result = {
-        "model": runtime.describe(),
-        "source": cfg.source,
-        "file": cfg.file,
-        "alarm_policy": dict(cfg.alarm),
-        "evidence_policy": dict(cfg.evidence),
-        **evaluator.result(),
-    }
-    stamp = datetime.now().strftime("%Y-%m-%d_%H-%M-%S")
-    out = Path(cfg.out or Path("outputs/monitor") / stamp / "online_eval.json")
-    atomic_write_json(out, result)
-    atomic_write_text(out.with_suffix(".md"), online_markdown(result))
-    alarms = result["alarms"]
-    print(
-        f"on-line accuracy {_num(result['online_accuracy'])}  localisation "
-        f"{_num(result['localisation_accuracy'])} | alarms: detected "
-        f"{alarms['detected']}/{alarms['episodes']} episodes, false alarms "
-        f"{_num(result['false_alarm_rate'])} of settled healthy ticks "
-        f"({_num(result['false_alarms_per_hour'])}/h), latency to class "
-        f"{_num(alarms['class_latency_s_median'])} s, to joint "
-        f"{_num(alarms['joint_latency_s_median'])} s (medians) -> {out}"
-    )
-    return result
+    if cfg.source != "ros2":
+        return monitor_stream(cfg, runtime, policy, evidence)
+    if cfg.model and cfg.ros2.layout == "joints":  # a stock arm's topics: joint channels only
+        refuse_lacking_data(cfg.model, "stock", "ros2.layout=joints")
+    from robohealth_mj.ros2.live import monitor_arms
 
-
-def _monitor_ros2(
-    cfg: DictConfig, runtime: ModelRuntime, policy: AlarmPolicy, evidence: EvidencePolicy
-) -> dict | None:
-    """``source=ros2``: live arms on the bus; with ``evaluate``, one on-line evaluation per arm
-    against its ``fault_state``, as for a replay."""
-    from robohealth_mj.ros2.live import run_monitor
-
-    settle = runtime.window + policy.clear_after + evidence.clearing_ticks
-    evaluators: dict[str, OnlineEvaluator] = {}
-
-    def evaluate(arm: str, sample: GraphSample, d: HealthDiagnosis) -> None:
-        if arm not in evaluators:
-            evaluators[arm] = OnlineEvaluator(settle_ticks=settle)
-        evaluators[arm].update(sample.fault, d, *joint_activity(sample.x))
-
-    counts = run_monitor(cfg.ros2, runtime, cfg.duration_s or None,
-                         evaluate if cfg.evaluate else None)  # fmt: skip
-    for arm, c in counts.items():
-        last = f" (last: {c['last_problem']})" if c["last_problem"] else ""
-        print(f"{arm}: {c['samples']} samples diagnosed, {c['problems']} bad inputs, "
-              f"{c['late']} late, {c['duplicates']} duplicate messages{last}")  # fmt: skip
-    if not cfg.evaluate:
-        return None
-    result = {arm: e.result() for arm, e in evaluators.items()}
-    stamp = datetime.now().strftime("%Y-%m-%d_%H-%M-%S")
-    out = Path(cfg.out or Path("outputs/monitor") / stamp / "online_eval_ros2.json")
-    atomic_write_json(out, {"model": runtime.describe(), "source": "ros2", "arms": result})
-    print(f"on-line evaluation of {len(result)} arms -> {out}")
-    return result
-
-
-def _print(stream_id: str, t: float, d: HealthDiagnosis, truth, last: str | None) -> str | None:
-    """Print an alarm raised or cleared, and each change of diagnosis with the truth."""
-    if d.alarm in ("raised", "cleared"):
-        where = f" @ {d.alarm_joint}" if d.alarm_joint else ""
-        print(f"t={t:8.2f}s {stream_id}: ALARM {d.alarm.upper()} {d.alarm_class or ''}{where}")
-    shown = describe(d)
-    if shown.split(" (")[0] == (last or "").split(" (")[0]:
-        return last
-    label = ""
-    if truth is not None:
-        label = (
-            f"   [truth: {truth.fault_class} @ {truth.joint} sev {truth.severity:g}]"
-            if truth.active
-            else "   [truth: healthy]"
-        )
-    print(f"t={t:8.2f}s {stream_id}: {shown}{label}", flush=True)
-    return shown
-
-
-def _num(value: float | None) -> str:
-    return "n/a" if value is None else f"{value:.3f}"
+    return monitor_arms(cfg, runtime, policy, evidence)
 
 
 if __name__ == "__main__":

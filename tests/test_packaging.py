@@ -38,7 +38,7 @@ TORCH_FREE = (
     "robohealth_mj.ros2.node",
     "robohealth_mj.ros2.live",
     "robohealth_mj.ros2.assembly",
-    "robohealth_mj.reporting.online",
+    "robohealth_mj.runtime.online_report",
 )
 
 _BLOCKER = f"""

@@ -1,3 +1,2 @@
-"""Campaign reports (tables and figures from a directory of finished runs) and the on-line
-evaluation's markdown. The package imports nothing on its own: ``reporting.online`` is read by
-the torch-free monitor, ``reporting.build`` needs the training stack."""
+"""Campaign reports: every table and figure of a directory of finished runs (``build``), from
+the runs' records (``tables``, ``archive``) and their figures (``figures``)."""

@@ -1,4 +1,5 @@
-"""Long-running loops on the bus: the monitor (``monitor source=ros2``) and simulated arms
+"""Long-running loops on the bus: the monitor (``monitor source=ros2``: :func:`monitor_arms`,
+with its on-line evaluation per arm) and simulated arms
 (``python -m robohealth_mj.robot``). Both stop cleanly on Ctrl-C or SIGTERM: the last
 ``/diagnostics`` is published and the participants are closed."""
 
@@ -13,7 +14,10 @@ from typing import Any
 
 from omegaconf import DictConfig
 
+from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.ros2 import require_dds
+from robohealth_mj.runtime.monitor import evaluation_path
+from robohealth_mj.runtime.online_eval import OnlineEvaluator, joint_activity
 from robohealth_mj.schema import GraphSample
 
 
@@ -128,3 +132,29 @@ def run_robot(cfg: DictConfig, stream: Iterator[tuple[float, GraphSample]]) -> i
             time.sleep(0.2)  # reliable writers flush before the participant goes
             bus.close()
     return ticks
+
+
+def monitor_arms(cfg: DictConfig, runtime: Any, policy: Any, evidence: Any) -> dict | None:
+    """``source=ros2``: live arms on the bus; with ``evaluate``, one on-line evaluation per arm
+    against its ``fault_state``, as for a replay."""
+    settle = runtime.window + policy.clear_after + evidence.clearing_ticks
+    evaluators: dict[str, OnlineEvaluator] = {}
+
+    def evaluate(arm: str, sample: GraphSample, d: Any) -> None:
+        if arm not in evaluators:
+            evaluators[arm] = OnlineEvaluator(settle_ticks=settle)
+        evaluators[arm].update(sample.fault, d, *joint_activity(sample.x))
+
+    counts = run_monitor(cfg.ros2, runtime, cfg.duration_s or None,
+                         evaluate if cfg.evaluate else None)  # fmt: skip
+    for arm, c in counts.items():
+        last = f" (last: {c['last_problem']})" if c["last_problem"] else ""
+        print(f"{arm}: {c['samples']} samples diagnosed, {c['problems']} bad inputs, "
+              f"{c['late']} late, {c['duplicates']} duplicate messages{last}")  # fmt: skip
+    if not cfg.evaluate:
+        return None
+    result = {arm: e.result() for arm, e in evaluators.items()}
+    out = evaluation_path(cfg.out, "online_eval_ros2.json")
+    atomic_write_json(out, {"model": runtime.describe(), "source": "ros2", "arms": result})
+    print(f"on-line evaluation of {len(result)} arms -> {out}")
+    return result
