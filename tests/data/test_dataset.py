@@ -9,9 +9,9 @@ import pytest
 from omegaconf import OmegaConf
 
 from robohealth_mj.common.config import compose_config
-from robohealth_mj.corpus import build_corpus, plan
 from robohealth_mj.data.read import read_samples
 from robohealth_mj.dataset import main as dataset_main
+from robohealth_mj.recording.corpus import build_corpus, plan
 from robohealth_mj.recording.recorder import GRAPHS_FILE, record_session
 from robohealth_mj.schema import SCHEMA_VERSION
 

@@ -5,8 +5,9 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from robohealth_mj.deploy.episode import render_episode
 from robohealth_mj.deploy.render import EpisodeRenderer
-from robohealth_mj.render import load_config, render_episode
+from robohealth_mj.render import load_config
 from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.model import HOME_POSE, ArmIndex, build_model
 
