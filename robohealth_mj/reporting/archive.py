@@ -3,7 +3,7 @@ and evaluations, a few kB, no checkpoint) into a directory that is committed wit
 
 A campaign's run directories live under ``outputs/`` with their checkpoints, which are large and
 git-ignored. A session that loses its machine loses them, and with them every per-seed number
-the report aggregates. The archive holds just what :func:`robohealth_mj.reporting.tables.collect`
+the report aggregates. The archive holds just what :func:`robohealth_mj.reporting.runs.collect`
 reads, at the same relative paths, so the report is rebuilt from it and a later session's runs
 join the earlier ones.
 """

@@ -7,17 +7,15 @@ from pathlib import Path
 from robohealth_mj.common.atomic import atomic_write_text
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.reporting.figures import figures
-from robohealth_mj.reporting.tables import (
-    aggregate,
-    collect,
-    cost_markdown,
-    coupling_markdown,
-    decomposition_markdown,
-    markdown,
-    severity_markdown,
-    visibility_markdown,
-    write_csv,
-)
+from robohealth_mj.reporting.runs import collect
+from robohealth_mj.reporting.statistics import aggregate
+from robohealth_mj.reporting.tables.cost import cost_markdown
+from robohealth_mj.reporting.tables.csv_rows import write_csv
+from robohealth_mj.reporting.tables.overview import markdown
+from robohealth_mj.reporting.tables.q1 import decomposition_markdown
+from robohealth_mj.reporting.tables.q2 import coupling_markdown
+from robohealth_mj.reporting.tables.severity import severity_markdown
+from robohealth_mj.reporting.tables.visibility import visibility_markdown
 
 __all__ = ["build_report"]
 

@@ -10,7 +10,8 @@ from typing import Any
 
 import numpy as np
 
-from robohealth_mj.reporting.tables import DECOMPOSITION, REFERENCE
+from robohealth_mj.reporting.runs import REFERENCE
+from robohealth_mj.reporting.tables.q1 import DECOMPOSITION
 from robohealth_mj.schema import FAULT_CLASSES
 
 HEADLINE = "anomaly_residual"

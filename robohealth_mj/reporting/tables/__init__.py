@@ -1,0 +1,1 @@
+"""One renderer per report table, each a function of the aggregated rows or of the runs."""
