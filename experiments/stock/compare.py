@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj.common.atomic import atomic_write_text
+from robohealth_mj.reporting.statistics import mean_pm_std
 
 RESULTS = Path(__file__).resolve().parents[2] / "results" / "stock"  # its tables live there
 
@@ -35,9 +36,7 @@ def row(profile: str, variant: str) -> str | None:
         return None
     ms = [json.loads(p.read_text())["metrics"] for p in evals]
 
-    def cell(values: list[float]) -> str:
-        return f"{np.mean(values):.3f} ± {np.std(values):.3f}"
-
+    cell = mean_pm_std
     cells = [
         cell([m["accuracy"] for m in ms]),
         cell([m["macro_f1"] for m in ms]),

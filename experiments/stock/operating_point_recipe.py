@@ -21,6 +21,7 @@ from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.deploy.commission import commission
 from robohealth_mj.deploy.operating_point import RECIPES
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
+from robohealth_mj.reporting.statistics import mean_pm_std
 
 RESULTS = Path(__file__).resolve().parents[2] / "results" / "stock"  # its tables live there
 
@@ -78,8 +79,8 @@ def main() -> None:
             loc = [r["localisation"] for r in group]
             recall = [f"{np.mean([r['recall'][c] for r in group]):.3f}" for c in CLASSES]
             lines.append(
-                f"| {variant} | {recipe} | {np.mean(acc):.3f} ± {np.std(acc):.3f} | "
-                f"{np.mean(loc):.3f} ± {np.std(loc):.3f} | " + " | ".join(recall) + " |"
+                f"| {variant} | {recipe} | {mean_pm_std(acc)} | "
+                f"{mean_pm_std(loc)} | " + " | ".join(recall) + " |"
             )
     out = RESULTS / "operating_point_recipe.md"
     atomic_write_text(out, "\n".join(lines) + "\n")

@@ -17,24 +17,17 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from robohealth_mj import schema
 from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
 from robohealth_mj.data.graphs import harness_graph
-from robohealth_mj.data.windows import make_windows
 from robohealth_mj.deploy import recouple
 from robohealth_mj.deploy.commission import commission
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
-from robohealth_mj.learn.checkpoint import model_from_checkpoint as build
-from robohealth_mj.learn.data import WindowTensors
-from robohealth_mj.learn.metrics import metrics_of
-from robohealth_mj.learn.placements import healthy_sensor_statistics
-from robohealth_mj.learn.predict import predict
+from robohealth_mj.learn.evaluation import score_under_placement
 
 CORPUS = os.environ.get("CORPUS", "outputs/corpus/standard")
 HEALTHY = f"{CORPUS}/healthy_nominal_seed940"
@@ -45,27 +38,15 @@ healthy = load_recordings([f"{HEALTHY}/graphs.jsonl"])
 held = load_recordings([f"{CORPUS}/heldout_seed900/graphs.jsonl"])
 
 
-def validation_windows(ckpt: dict, rec: Recording):
-    """The windows of ``rec`` in the checkpoint's validation runs."""
-    windows = make_windows(rec, int(ckpt["window"]))
-    runs = list(ckpt["split_runs"]["val"])
-    return windows.subset(np.isin(np.asarray(rec.run_ids)[rec.run[windows.end]], runs))
+def acc_loc(m: dict) -> np.ndarray:
+    return np.array([m["accuracy"], m["localisation_accuracy"]])
 
 
 def score(ckpt: dict, c: np.ndarray, data: Recording, val_only: bool) -> np.ndarray:
     """Accuracy and localisation of ``ckpt`` told placement ``c`` (its sensors z-scored on the
     arm's healthy running) on ``data`` mixed by ``c``; ``val_only``: its validation runs."""
-    graph = replace(graph_from_checkpoint(ckpt), coupling=c)
-    rec = graph.relabel(data)
-    mean, std = ckpt["norm_mean"].numpy().copy(), ckpt["norm_std"].numpy().copy()
-    j, s = graph.num_joints, schema.SENSOR_CHANNELS
-    mean[j:, s], std[j:, s] = healthy_sensor_statistics(graph, healthy.x)
-    model = build(ckpt)
-    model.anomaly.set_coupling(c)
-    t = WindowTensors(graph.transform(rec.x), rec, mean, std, torch.device("cpu"))
-    windows = validation_windows(ckpt, rec) if val_only else make_windows(rec, int(ckpt["window"]))
-    m = metrics_of(predict(model, t, windows))
-    return np.array([m["accuracy"], m["localisation_accuracy"]])
+    return acc_loc(score_under_placement(ckpt, data, c, healthy=healthy, tell_model=True,
+                                         validation_only=val_only))  # fmt: skip
 
 
 def self_calibrated(
@@ -78,14 +59,9 @@ def self_calibrated(
                             placement_prune=prune)  # fmt: skip
         ckpt = load_checkpoint(Path(out) / "best.ckpt")
     truth = harness_graph(coupling_seed=seed, coupling_sensors=4).coupling
-    graph = replace(graph_from_checkpoint(ckpt), coupling=truth)  # the arm mixes by the truth
-    rec = graph.relabel(data)
-    t = WindowTensors(graph.transform(rec.x), rec, ckpt["norm_mean"].numpy(),
-                      ckpt["norm_std"].numpy(), torch.device("cpu"))  # fmt: skip
-    m = metrics_of(predict(build(ckpt), t, validation_windows(ckpt, rec)))  # C: the fitted one
-    return np.array([m["accuracy"], m["localisation_accuracy"]]), record["placement"][
-        "coupling_correlation"
-    ]
+    # the arm mixes by the truth; the model reads it through the C it was fitted
+    m = score_under_placement(ckpt, data, truth, validation_only=True)
+    return acc_loc(m), record["placement"]["coupling_correlation"]
 
 
 def fmt(s: np.ndarray) -> str:

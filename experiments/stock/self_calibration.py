@@ -18,23 +18,16 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from robohealth_mj import schema
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.graphs import harness_graph
-from robohealth_mj.data.windows import make_windows
 from robohealth_mj.deploy.commission import commission
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
-from robohealth_mj.learn.checkpoint import model_from_checkpoint as build
-from robohealth_mj.learn.data import WindowTensors
-from robohealth_mj.learn.metrics import metrics_of
-from robohealth_mj.learn.placements import healthy_sensor_statistics
-from robohealth_mj.learn.predict import predict
+from robohealth_mj.learn.evaluation import score_under_placement
 
 CORPUS = os.environ.get("CORPUS", "outputs/corpus/standard")
 RUNS = "outputs/thesis_physics/harness/retrofit"
@@ -45,27 +38,18 @@ held_all = load_recordings([f"{CORPUS}/heldout_seed900/graphs.jsonl"])
 healthy = load_recordings([f"{HEALTHY}/graphs.jsonl"])
 
 
-def score(ckpt: dict, model=None) -> tuple[float, float]:
-    """Accuracy and localisation on the held-out session, read through the checkpoint's graph."""
-    graph = graph_from_checkpoint(ckpt)
-    held = graph.relabel(held_all)
-    mean, std = ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()
-    t = WindowTensors(graph.transform(held.x), held, mean, std, torch.device("cpu"))
-    m = metrics_of(predict(model or build(ckpt), t, make_windows(held, int(ckpt["window"]))))
+def acc_loc(m: dict) -> tuple[float, float]:
     return m["accuracy"], m["localisation_accuracy"]
+
+
+def score(ckpt: dict) -> tuple[float, float]:
+    """Accuracy and localisation on the held-out session, read through the checkpoint's graph."""
+    return acc_loc(score_under_placement(ckpt, held_all))
 
 
 def given(ckpt: dict, c: np.ndarray) -> tuple[float, float]:
     """The pool model told the placement: C set to it, sensors z-scored on its healthy run."""
-    graph = replace(graph_from_checkpoint(ckpt), coupling=c)
-    mean, std = ckpt["norm_mean"].numpy().copy(), ckpt["norm_std"].numpy().copy()
-    j, S = graph.num_joints, schema.SENSOR_CHANNELS
-    mean[j:, S], std[j:, S] = healthy_sensor_statistics(graph, healthy.x)
-    model = build(ckpt)
-    model.anomaly.set_coupling(c)
-    told = {**ckpt, "graph": graph.as_dict(), "norm_mean": torch.from_numpy(mean),
-            "norm_std": torch.from_numpy(std)}  # fmt: skip
-    return score(told, model)
+    return acc_loc(score_under_placement(ckpt, held_all, c, healthy=healthy, tell_model=True))
 
 
 def commissioned(path: str, seed: int, fit: str = "motion") -> tuple[tuple[float, float], float]:

@@ -29,17 +29,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from robohealth_mj import schema
 from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
 from robohealth_mj.data.graphs import coupling_correlation, harness_graph
-from robohealth_mj.data.windows import make_windows
 from robohealth_mj.deploy.recouple import motion_estimate
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
-from robohealth_mj.learn.checkpoint import model_from_checkpoint as build
-from robohealth_mj.learn.data import WindowTensors
-from robohealth_mj.learn.metrics import metrics_of
-from robohealth_mj.learn.placements import healthy_sensor_statistics
-from robohealth_mj.learn.predict import predict
+from robohealth_mj.learn.evaluation import score_under_placement
 
 CORPUS = os.environ.get("CORPUS", "outputs/corpus/standard")
 RUNS = Path("outputs/thesis_physics/harness/retrofit")
@@ -56,18 +50,9 @@ def score(
     """Accuracy and localisation on the held-out session (or ``data``: the validation runs of
     the training sessions) mixed by ``truth``; with ``refit`` the sensors are z-scored on the
     arm's healthy running (what commissioning can measure)."""
-    graph = replace(graph_from_checkpoint(ckpt), coupling=truth)
-    rec = graph.relabel(held_all if data is None else data)
-    mean, std = ckpt["norm_mean"].numpy().copy(), ckpt["norm_std"].numpy().copy()
-    if refit:
-        j, s = graph.num_joints, schema.SENSOR_CHANNELS
-        mean[j:, s], std[j:, s] = healthy_sensor_statistics(graph, healthy.x)
-    t = WindowTensors(graph.transform(rec.x), rec, mean, std, torch.device("cpu"))
-    windows = make_windows(rec, int(ckpt["window"]))
-    if data is not None:  # the checkpoint's validation runs only
-        runs = list((ckpt.get("split_runs") or {}).get("val", []))
-        windows = windows.subset(np.isin(np.asarray(rec.run_ids)[rec.run[windows.end]], runs))
-    m = metrics_of(predict(build(ckpt), t, windows))
+    m = score_under_placement(ckpt, held_all if data is None else data, truth,
+                              healthy=healthy if refit else None,
+                              validation_only=data is not None)  # fmt: skip
     return m["accuracy"], m["localisation_accuracy"]
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.deploy.commission import commission
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
+from robohealth_mj.reporting.statistics import mean_pm_std
 
 RESULTS = Path(__file__).resolve().parents[2] / "results" / "stock"  # its tables live there
 
@@ -159,8 +160,7 @@ def alarm_lines() -> list[str]:
     return lines
 
 
-def _ms(values: list[float]) -> str:
-    return f"{np.mean(values):.3f} ± {np.std(values):.3f}"
+_ms = mean_pm_std
 
 
 def table(rows: dict) -> str:

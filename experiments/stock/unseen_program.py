@@ -22,6 +22,7 @@ import numpy as np
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.deploy.commission import commission
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
+from robohealth_mj.reporting.statistics import mean_pm_std
 
 RESULTS = Path(__file__).resolve().parents[2] / "results" / "stock"  # its tables live there
 
@@ -75,8 +76,7 @@ def main() -> None:
             sets = [r[key] for r in group]
 
             def ms(k: str, sets=sets) -> str:
-                v = [s[k] for s in sets]
-                return f"{np.mean(v):.3f} ± {np.std(v):.3f}"
+                return mean_pm_std([s[k] for s in sets])
 
             recalls = [f"{np.mean([s['recall'][c] for s in sets]):.3f}" for c in CLASSES]
             cells = [ms("accuracy"), ms("localisation"), ms("moving"), *recalls]

@@ -4,13 +4,17 @@ from __future__ import annotations
 
 import csv
 import io
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+import torch
+
+from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
-from robohealth_mj.data.arrays import expand_paths, load_recordings
-from robohealth_mj.data.windows import make_windows, target_joint_moved
+from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
+from robohealth_mj.data.windows import Windows, make_windows, target_joint_moved
 from robohealth_mj.learn.checkpoint import (
     check_recordings,
     graph_from_checkpoint,
@@ -19,6 +23,7 @@ from robohealth_mj.learn.checkpoint import (
 )
 from robohealth_mj.learn.data import WindowTensors
 from robohealth_mj.learn.metrics import flat_rows, metrics_of
+from robohealth_mj.learn.placements import healthy_sensor_statistics
 from robohealth_mj.learn.predict import Predictions, predict
 from robohealth_mj.learn.trainer import coupling_report, gamma_of, pick_device
 
@@ -86,3 +91,46 @@ def write_evaluation(result: dict[str, Any], prefix: Path | str) -> tuple[Path, 
     atomic_write_text(csv_path, buffer.getvalue())
     atomic_write_json(json_path, result)  # last: its presence marks the evaluation as done
     return json_path, csv_path
+
+
+def validation_windows(ckpt: dict[str, Any], rec: Recording) -> Windows:
+    """The windows of ``rec`` in the checkpoint's validation runs: the split its training
+    selected on, and the only one a design choice may be made on."""
+    windows = make_windows(rec, int(ckpt["window"]))
+    runs = list((ckpt.get("split_runs") or {}).get("val", []))
+    return windows.subset(np.isin(np.asarray(rec.run_ids)[rec.run[windows.end]], runs))
+
+
+def score_under_placement(
+    ckpt: dict[str, Any],
+    data: Recording,
+    coupling: np.ndarray | None = None,
+    *,
+    healthy: Recording | None = None,
+    tell_model: bool = False,
+    validation_only: bool = False,
+    model: Any = None,
+) -> dict[str, Any]:
+    """The metrics of a checkpoint's model (or ``model``) on ``data`` as an arm whose sensor
+    packages are mixed by ``coupling`` (default: the checkpoint's own) reads it.
+
+    ``healthy``: the sensors z-scored on that healthy running instead of the training
+    statistics (what commissioning can measure on the arm); ``tell_model``: the model's coupling
+    set to ``coupling`` (a pool model told the placement); ``validation_only``: the checkpoint's
+    validation runs of ``data`` only."""
+    graph = graph_from_checkpoint(ckpt)
+    if coupling is not None:
+        graph = replace(graph, coupling=coupling)
+    rec = graph.relabel(data)
+    mean, std = ckpt["norm_mean"].numpy().copy(), ckpt["norm_std"].numpy().copy()
+    if healthy is not None:
+        j, s = graph.num_joints, schema.SENSOR_CHANNELS
+        mean[j:, s], std[j:, s] = healthy_sensor_statistics(graph, healthy.x)
+    model = model_from_checkpoint(ckpt) if model is None else model
+    if tell_model:
+        model.anomaly.set_coupling(coupling)
+    tensors = WindowTensors(graph.transform(rec.x), rec, mean, std, torch.device("cpu"))
+    windows = (
+        validation_windows(ckpt, rec) if validation_only else make_windows(rec, int(ckpt["window"]))
+    )
+    return metrics_of(predict(model, tensors, windows))

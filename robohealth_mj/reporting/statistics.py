@@ -32,6 +32,11 @@ def fmt_stat(stat: tuple[float, float, int], digits: int = 3) -> str:
     return "—" if n == 0 else f"{mean:.{digits}f} ± {std:.{digits}f}"
 
 
+def mean_pm_std(values: list[float | None], digits: int = 3) -> str:
+    """``mean ± std`` of the finite values, as every results table prints it (``—`` if none)."""
+    return fmt_stat(mean_std(values), digits)
+
+
 def aggregate(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     rows = []
     for (setting, label, window), members in grouped(runs):

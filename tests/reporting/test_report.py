@@ -256,3 +256,12 @@ def test_q2_differences_are_paired_per_seed_and_per_harness_setting(tmp_path):
         ["| harness/full/C0", "16", "1", "stgnn_fixed", "+0.100 ± 0.000"],
     ]
     assert rows[0][5] == "+0.100 ± 0.000"  # accuracy 0.8 - 0.7 on both seeds
+
+
+def test_mean_pm_std_is_the_tables_cell_over_the_finite_values():
+    """The one ``mean ± std`` every results table and research script prints."""
+    from robohealth_mj.reporting.statistics import mean_pm_std
+
+    assert mean_pm_std([0.8312, 0.8401, 0.8233]) == "0.832 ± 0.007"
+    assert mean_pm_std([0.5, None, float("nan"), 0.7], digits=2) == "0.60 ± 0.10"
+    assert mean_pm_std([]) == "—"
