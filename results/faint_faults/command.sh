@@ -48,7 +48,7 @@ for s in corpus/standard/heldout_seed900 alarm_selection/healthy903; do
   $PY -m robohealth_mj.monitor model=$NEW source=replay file=outputs/$s/graphs.jsonl evaluate=true quiet=true \
     $MEMORY out=$OUT/online_eval_deconf_memory_$n.json
 done
-$PY $OUT/tabulate.py > $OUT/online.md
+$PY experiments/faint_faults/tabulate.py > $OUT/online.md
 
 # memory must not cost the fleet: step time with and without it, alternated, at 1,000 streams
 $PY -m robohealth_mj.bench streams --model $NEW --no-search --seconds 10 > $OUT/bench_streams_memory.txt
