@@ -18,10 +18,12 @@ A sensor node's joint-state channels are its joint's, so the joint topics carry 
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
+from robohealth_mj.bags.joints import joint_order
 from robohealth_mj.bags.topics import VIBRATION_FIELDS, BagTopics
 from robohealth_mj.data.jsonl import node_features
 from robohealth_mj.schema import (
@@ -264,23 +266,27 @@ def sample_from_messages(
     vibs: list[Any] | None,
     fault: Any | None,
     where,
+    joints: Sequence[str] = JOINT_NAMES,
 ) -> GraphSample:
     """Assemble one GraphSample; ``where(topic_key, message)`` makes the error for a bad field.
-    Without the sensor messages the sensor channels stay zero; without ``fault`` the sample is
-    healthy, numbered 0 (the reader numbers such samples by stamp)."""
-    for key, msg in (("joint_states", state), ("joint_errors", errors)):
-        if list(msg.name) != list(JOINT_NAMES):
-            raise where(key, f"field 'name': {list(msg.name)} is not {list(JOINT_NAMES)}")
+    ``joints``: the names the joint messages give the six joints, base to tool (found by name,
+    in any order). Without the sensor messages the sensor channels stay zero; without ``fault``
+    the sample is healthy, numbered 0 (the reader numbers such samples by stamp)."""
+    columns = []
     for key, msg, fields in (
         ("joint_states", state, ("position", "velocity", "effort")),
         ("joint_errors", errors, ("position", "effort")),
     ):
+        try:
+            order = joint_order(msg.name, joints)
+        except ValueError as exc:
+            raise where(key, str(exc)) from None
         for name in fields:
-            if len(getattr(msg, name)) != N_JOINTS:
-                raise where(key, f"field '{name}': {len(getattr(msg, name))} values, not 6")
-    joint_state = np.stack(
-        [state.position, state.velocity, state.effort, errors.position, errors.effort], axis=-1
-    )
+            values = getattr(msg, name)
+            if len(values) != len(msg.name):
+                raise where(key, f"field '{name}': {len(values)} values, not {len(msg.name)}")
+            columns.append(values if order is None else np.asarray(values)[order])
+    joint_state = np.stack(columns, axis=-1)
     sensor = np.zeros((N_JOINTS, SENSOR_CHANNELS.stop - SENSOR_CHANNELS.start))
     vib_at = [FEATURE_NAMES.index(v) - SENSOR_CHANNELS.start for v in VIBRATION_FIELDS]
     acc_at = [FEATURE_NAMES.index(a) - SENSOR_CHANNELS.start for a in ("acc_x", "acc_y", "acc_z")]

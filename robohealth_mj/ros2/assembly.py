@@ -19,6 +19,7 @@ reported missing (``late``).
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -63,8 +64,10 @@ class ArmAssembler:
         late_ticks: int = 10,
         aggregated: str | None = None,
         sensors: bool = True,
+        joints: Sequence[str] = JOINT_NAMES,
     ) -> None:
         self.arm, self.topics, self.aggregated = arm, topics, aggregated
+        self.joints = tuple(joints)  # what this arm's JointState messages call its joints
         self.require_truth, self.late_ticks, self.sensors = require_truth, late_ticks, sensors
         if aggregated:  # one array per tick carries the whole snapshot
             self.vibration, self.imu, self.stamped = [], [], [aggregated]
@@ -207,15 +210,32 @@ class ArmAssembler:
                     vibs if self.sensors else None,
                     truth,
                     where,
+                    self.joints,
                 )
         except (AttributeError, TypeError, ValueError) as exc:
             raise _Problem(f"{at}: malformed message ({exc})") from None
         bad = np.argwhere(~np.isfinite(sample.x))
         if bad.size:
             node, feat = bad[0]
-            raise _Problem(f"{at}: NaN or Inf in x[{NODE_NAMES[node]}].{FEATURE_NAMES[feat]}")
+            topic = self._topic_of(int(node), FEATURE_NAMES[feat])
+            raise _Problem(
+                f"topic '{topic}' {at}: NaN or Inf in x[{NODE_NAMES[node]}].{FEATURE_NAMES[feat]}"
+            )
         self.count += 1
         return sample
+
+    def _topic_of(self, node: int, feature: str) -> str:
+        """The topic that carried ``feature`` of ``node``: joint state and tracking error are
+        every node's own joint's, the package's channels its sensor's."""
+        if self.aggregated:
+            return self.aggregated
+        joint = JOINT_NAMES[node % len(JOINT_NAMES)]
+        if feature in ("pos", "vel", "effort"):
+            return self.topics.joint_states
+        if feature in ("pos_error", "effort_residual"):
+            return self.topics.joint_errors
+        kind = self.topics.imu if feature.startswith("acc_") else self.topics.vibration
+        return kind.format(joint=joint)
 
 
 class _NoTruth:

@@ -73,7 +73,8 @@ def run_monitor(
     bus = Bus(bus_config(cfg))
     node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
                        stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
-                       layout=str(cfg.layout))  # fmt: skip
+                       layout=str(cfg.layout), joint_names=cfg.get("joint_names", "schema"),
+                       tf_prefix=str(cfg.get("tf_prefix") or ""))  # fmt: skip
     started = time.monotonic()
     last_report = started
     print(f"ros2 monitor: {len(arms)} arms on domain {cfg.domain_id} ({', '.join(arms[:5])}"

@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import time
 import zlib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from robohealth_mj.bags.joints import joint_names as arm_joint_names
 from robohealth_mj.bags.messages import MessageFactory
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.ros2.assembly import ArmAssembler
@@ -131,7 +132,11 @@ class MonitorNode:
         keep_diagnoses: bool = False,
         on_diagnosis: Callable[[str, GraphSample, Any], None] | None = None,
         layout: str = "per_sensor",
+        joint_names: str | Sequence[str] = "schema",
+        tf_prefix: str = "",
     ) -> None:
+        """``joint_names`` (a preset of ``conf/joint_names.yaml`` or six names) and ``tf_prefix``
+        (``{arm}`` is the arm's name) say what each arm's JointState messages call its joints."""
         self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
         self.keep_diagnoses, self.on_diagnosis = keep_diagnoses, on_diagnosis
         # where the monitor's time goes (the benchmark reports it): take (DDS read and CDR
@@ -147,8 +152,10 @@ class MonitorNode:
             names = arm_topics(arm, topics)
             kinds = layout_topics(names, layout)
             aggregated = names.aggregated if layout == "aggregated" else None
+            joints = arm_joint_names(joint_names, tf_prefix.format(arm=arm))
             assembler = ArmAssembler(arm, names, require_truth=require_truth,
-                                     aggregated=aggregated, sensors=layout != "joints")  # fmt: skip
+                                     aggregated=aggregated, sensors=layout != "joints",
+                                     joints=joints)  # fmt: skip
             readers = [
                 (t, TYPES[kinds[t]], bus.reader(t, TYPES[kinds[t]]))
                 for t in assembler.topic_names()

@@ -23,6 +23,7 @@ from robohealth_mj.ros2.bus import Bus, BusConfig
 from robohealth_mj.ros2.idl import IdlStore
 from robohealth_mj.ros2.node import ArmPublisher, MonitorNode, arm_topics, in_partition
 from robohealth_mj.runtime.runtime import ModelRuntime
+from robohealth_mj.schema import JOINT_NAMES
 
 # One domain per test (a DDS domain id is 0..232), so tests never see each other's traffic.
 _DOMAINS = itertools.count(100 + os.getpid() % 50 * 2)
@@ -144,6 +145,57 @@ def test_a_backlog_duplicates_and_late_messages_are_told_apart_from_bad_input(de
     got, problems = _feed(ArmAssembler("arm7", topics), stream, counts=counts)
     assert len(got) == 15 and len(problems) == 1 and "message missing" in problems[0]
     assert counts == {"duplicates": 0, "late": 1}
+
+
+def test_a_ur_driver_s_joint_names_in_its_order_assemble_to_the_same_sample(deployed):
+    """The UR ROS 2 driver names the joints ``<tf_prefix>shoulder_pan_joint`` ... and lists them
+    alphabetically: found by name, the sample is the one the schema's names give; a joint the
+    message lacks, or a NaN, is one problem naming the topic."""
+    from robohealth_mj.bags.joints import joint_names
+
+    samples = list(itertools.islice(read_samples(deployed["heldout"]), 3))
+    topics = arm_topics("arm7")
+    factory = MessageFactory(IdlStore())
+    driver = joint_names("ur_driver", "arm7_")
+    rename = dict(zip(JOINT_NAMES, driver, strict=True))
+
+    def as_driver(msg):  # the driver's names, sorted, every array permuted alike
+        order = sorted(range(6), key=lambda k: rename[msg.name[k]])
+        msg.name = [rename[msg.name[k]] for k in order]
+        for field in ("position", "velocity", "effort"):
+            values = getattr(msg, field)
+            if len(values) == 6:
+                setattr(msg, field, [values[k] for k in order])
+        return msg
+
+    def ticks():
+        out = []
+        for s in samples:
+            msgs = factory.sample_messages(s, topics)
+            out += [(t, as_driver(m) if t in (topics.joint_states, topics.joint_errors) else m)
+                    for t, m in msgs]  # fmt: skip
+        return out
+
+    got, problems = _feed(ArmAssembler("arm7", topics, joints=driver), ticks())
+    assert problems == [] and len(got) == 3
+    for a, b in zip(got, samples, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+    _, problems = _feed(ArmAssembler("arm7", topics), ticks())  # the schema's names: refused
+    assert len(problems) == 3 and "joint 'shoulder_pan' missing (6 of 6" in problems[0]
+
+    broken = ticks()
+    state = broken[0][1]
+    state.name, state.position = state.name[1:], state.position[1:]
+    state.velocity, state.effort = state.velocity[1:], state.effort[1:]
+    vib = next(m for t, m in broken[15:30] if t.endswith("/wrist_1/vibration"))
+    vib.data = [float("inf"), *vib.data[1:]]
+    got, problems = _feed(ArmAssembler("arm7", topics, joints=driver), broken)
+    assert len(got) == 1 and len(problems) == 2
+    assert problems[0].startswith("topic '/arm7/joint_states' at stamp")
+    assert problems[0].endswith("joint 'arm7_elbow_joint' missing (1 of 6; the message names "
+                                f"{state.name})")  # fmt: skip
+    assert problems[1].startswith("topic '/arm7/sensors/wrist_1/vibration' at stamp")
+    assert problems[1].endswith("NaN or Inf in x[wrist_1_sensor].vib")
 
 
 def test_a_fleet_is_split_by_namespace_hash_with_every_arm_in_one_share():
