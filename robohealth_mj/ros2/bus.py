@@ -7,10 +7,15 @@
   by default, because a best-effort reader matches both reliable and best-effort writers.
 - Fast DDS 3 peers (recent ROS 2's default middleware) advertise type information that Cyclone
   rejects unless told to ignore it for their vendor id (``Compatibility/IgnoreTypeInformation``).
+- ``CYCLONEDDS_URI``, the way a ROS 2 user configures Cyclone (interfaces, peers, shared memory),
+  is honoured: Cyclone reads a comma-separated list of XML and files with later entries
+  overriding earlier ones, so the domain gets this project's settings followed by the user's.
 """
 
 from __future__ import annotations
 
+import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 from xml.sax.saxutils import escape
@@ -52,6 +57,13 @@ class BusConfig:
         return f'<CycloneDDS><Domain id="any">{general}{discovery}{compat}</Domain></CycloneDDS>'
 
 
+def domain_config(config: BusConfig, environ: Mapping[str, str] = os.environ) -> str:
+    """The domain's configuration: ours, then ``CYCLONEDDS_URI``'s where set (the user's wins
+    where both say something). Cyclone ignores the variable once a domain is given a config."""
+    user = environ.get("CYCLONEDDS_URI", "").strip()
+    return f"{config.xml()},{user}" if user else config.xml()
+
+
 def dds_topic(ros_name: str) -> str:
     """``/a/b`` -> ``rt/a/b``."""
     return "rt/" + ros_name.lstrip("/")
@@ -63,7 +75,7 @@ _DOMAINS: dict[int, tuple[str, Any]] = {}  # Cyclone allows one configured domai
 def _domain(config: BusConfig) -> Any:
     from cyclonedds.domain import Domain
 
-    xml = config.xml()
+    xml = domain_config(config)
     known = _DOMAINS.get(config.domain_id)
     if known is None:
         known = _DOMAINS[config.domain_id] = (xml, Domain(config.domain_id, xml))

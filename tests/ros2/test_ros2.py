@@ -198,6 +198,23 @@ def test_a_ur_driver_s_joint_names_in_its_order_assemble_to_the_same_sample(depl
     assert problems[1].endswith("NaN or Inf in x[wrist_1_sensor].vib")
 
 
+def test_cyclonedds_uri_is_merged_after_the_project_s_settings(tmp_path, monkeypatch):
+    """A ROS 2 user's ``CYCLONEDDS_URI`` reaches the domain (here: a trace file it asks for),
+    after the project's own settings, which stay (the loopback interface is in the trace)."""
+    from robohealth_mj.ros2.bus import domain_config
+
+    config = _bus()
+    assert domain_config(config, {}) == config.xml()
+    trace = tmp_path / "cyclone.log"
+    user = (f'<CycloneDDS><Domain id="any"><Tracing><Verbosity>config</Verbosity>'
+            f"<OutputFile>{trace}</OutputFile></Tracing></Domain></CycloneDDS>")  # fmt: skip
+    assert domain_config(config, {"CYCLONEDDS_URI": user}) == f"{config.xml()},{user}"
+    monkeypatch.setenv("CYCLONEDDS_URI", user)
+    bus = Bus(config)
+    bus.close()
+    assert trace.is_file() and "127.0.0.1" in trace.read_text()
+
+
 def test_a_fleet_is_split_by_namespace_hash_with_every_arm_in_one_share():
     arms = [f"arm{k}" for k in range(40)]
     shares = [[a for a in arms if in_partition(a, f"{k}/3")] for k in range(3)]
