@@ -166,6 +166,8 @@ def _imports(path: Path) -> list[tuple[str, list[str], int]]:
 
 
 SCRIPTS = sorted((REPO / "experiments").rglob("*.py"))
+# rclpy and the ROS message packages: installed by experiments/ros2/*.sh in a venv of their own
+ROS_VENV = ("rclpy", "sensor_msgs", "diagnostic_msgs", "std_msgs", "builtin_interfaces")
 
 
 @pytest.mark.parametrize("script", SCRIPTS, ids=[str(p.relative_to(REPO)) for p in SCRIPTS])
@@ -176,6 +178,8 @@ def test_a_research_script_imports_only_what_exists(script):
     for module, names, line in _imports(script):
         where = f"{script.relative_to(REPO)}:{line}"
         if not module.startswith("robohealth_mj"):
+            if module.split(".")[0] in ROS_VENV:  # a real ROS 2 node's side, run in its own venv
+                continue
             assert importlib.util.find_spec(module.split(".")[0]), f"{where}: no module {module}"
             continue
         loaded = importlib.import_module(module)

@@ -7,6 +7,9 @@
   by default, because a best-effort reader matches both reliable and best-effort writers.
 - Fast DDS 3 peers (recent ROS 2's default middleware) advertise type information that Cyclone
   rejects unless told to ignore it for their vendor id (``Compatibility/IgnoreTypeInformation``).
+  Measured against rclpy on Fast DDS (``experiments/ros2/type_information.sh``): without it no
+  message passes either way, with it every one does, so it is on by default; it concerns only
+  that vendor id, so Cyclone peers are unaffected.
 - ``CYCLONEDDS_URI``, the way a ROS 2 user configures Cyclone (interfaces, peers, shared memory),
   is honoured: Cyclone reads a comma-separated list of XML and files with later entries
   overriding earlier ones, so the domain gets this project's settings followed by the user's.
@@ -27,7 +30,7 @@ EPROSIMA_VENDOR_ID = "1.15"  # Fast DDS's RTPS vendor id, as Cyclone writes it
 class BusConfig:
     domain_id: int = 0  # ROS_DOMAIN_ID
     interface: str | None = None  # an address or interface name; None: Cyclone's choice
-    ignore_type_information: bool = False  # for Fast DDS 3 peers
+    ignore_type_information: bool = True  # Fast DDS 3 peers: without it nothing passes
     reliable_subscriptions: bool = False  # default: best effort (matches every writer)
     depth: int = 10  # history depth of readers and writers
 
