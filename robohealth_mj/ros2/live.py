@@ -89,6 +89,8 @@ def run_monitor(
                     time.sleep(float(cfg.poll_s))  # every reader is not free)
                 if now - last_report >= float(cfg.diagnostics_period_s):
                     node.publish_diagnostics(time.time())
+                    for arm, problem in node.reported:  # as it happens, not only at the end
+                        print(f"{arm}: {problem}", flush=True)
                     last_report = now
         finally:
             node.publish_diagnostics(time.time())  # the last word on every arm

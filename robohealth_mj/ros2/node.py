@@ -147,6 +147,7 @@ class MonitorNode:
         self._publishing = 0.0
         self.factory = MessageFactory(IdlStore())
         self.arms: dict[str, ArmState] = {}
+        self.reported: list[tuple[str, str]] = []  # (arm, problem) of the last /diagnostics
         self.diagnosis_writers: dict[str, Any] = {}
         for arm in arms:
             names = arm_topics(arm, topics)
@@ -278,6 +279,8 @@ class MonitorNode:
             status=[self.arm_status(arm, now) for arm in self.arms],
         )
         self.diagnostics.write(array)
+        # what this period reported, for the monitor's own log (one line an arm at most)
+        self.reported = [(arm, s.problem) for arm, s in self.arms.items() if s.problem]
         for state in self.arms.values():
             state.problem = None  # a problem is reported once, then the arm recovers
         return array

@@ -392,6 +392,8 @@ def test_a_topic_of_the_wrong_type_and_a_robot_that_goes_silent_and_returns_mark
         status["arm2"].level == 1 and "cannot match a JointState reader" in status["arm2"].message
     )
     assert "bad input" not in status["arm1"].message
+    assert [arm for arm, _ in node.reported] == ["arm2"]  # the line the monitor prints
+    assert "topic '/arm2/joint_states'" in node.reported[0][1]
     for s in samples[10:20]:  # arm2 goes silent
         arms["arm1"].publish(s)
     _spin(node, lambda: node.arms["arm1"].samples >= 20)
