@@ -86,17 +86,17 @@ def test_a_fastdds_node_with_the_ur_driver_s_names_is_diagnosed_by_default(
     ticks.write_text(json.dumps(_driver_ticks(Path(stock_deployed["heldout"]), "arm1")))
     heard, log = tmp_path / "heard.json", tmp_path / "monitor.log"
     monitor = [sys.executable, "-m", "robohealth_mj.monitor", f"model={stock_deployed['onnx']}",
-               "source=ros2", "duration_s=16", "ros2.interface=127.0.0.1", "ros2.arms=[arm1]",
+               "source=ros2", "duration_s=0", "ros2.interface=127.0.0.1", "ros2.arms=[arm1]",
                "ros2.layout=joints", "ros2.joint_names=ur_driver", "ros2.tf_prefix='{arm}_'",
                "ros2.require_truth=false"]  # fmt: skip
     script = (
         "set -e; ip link set lo up; ip link set lo multicast on; "
         "ip route add 224.0.0.0/4 dev lo; "
-        f"{shlex.join(monitor)} > {log} 2>&1 & "
-        f"{ros_python} {NODE} {ticks} arm1 {heard}; wait"
+        f"{shlex.join(monitor)} > {log} 2>&1 & monitor=$!; "
+        f"{ros_python} {NODE} {ticks} arm1 {heard}; kill -TERM $monitor; wait $monitor"
     )
     done = subprocess.run(["unshare", "-n", "bash", "-c", script], capture_output=True,
-                          text=True, timeout=120)  # fmt: skip
+                          text=True, timeout=180)  # fmt: skip
     output = log.read_text() if log.is_file() else ""
     assert done.returncode == 0, done.stderr[-2000:] + output[-2000:]
     assert f"arm1: {TICKS} samples diagnosed, 0 bad inputs, 0 late" in output, output[-2000:]

@@ -32,10 +32,17 @@ def main() -> None:
         return lambda _msg: heard.__setitem__(key, heard[key] + 1)
 
     node.create_subscription(DiagnosticArray, "/diagnostics", count("diagnostics"), 10)
-    node.create_subscription(DiagnosticArray, f"/{arm}/health_diagnosis",
-                             count("health_diagnosis"), 100)  # fmt: skip
-    started = time.monotonic()
-    while time.monotonic() - started < 3.0:  # discovery
+    diagnoses = node.create_subscription(DiagnosticArray, f"/{arm}/health_diagnosis",
+                                         count("health_diagnosis"), 100)  # fmt: skip
+    deadline = time.monotonic() + 60.0  # discovery: until the monitor is matched both ways
+    while time.monotonic() < deadline and not (
+        states.get_subscription_count()
+        and errors.get_subscription_count()
+        and diagnoses.get_publisher_count()
+    ):
+        rclpy.spin_once(node, timeout_sec=0.05)
+    settled = time.monotonic() + 2.0  # our side has matched; give the monitor's readers
+    while time.monotonic() < settled:  # time to match ours, or the first ticks go to nobody
         rclpy.spin_once(node, timeout_sec=0.05)
     for tick in ticks["ticks"]:
         for publisher, fields in ((states, ("position", "velocity", "effort")),
@@ -52,8 +59,10 @@ def main() -> None:
         deadline = time.monotonic() + 0.05
         while time.monotonic() < deadline:
             rclpy.spin_once(node, timeout_sec=0.01)
-    deadline = time.monotonic() + 4.0  # the last diagnoses and a /diagnostics period
-    while time.monotonic() < deadline:
+    deadline = time.monotonic() + 30.0  # every diagnosis back, and a /diagnostics period
+    while time.monotonic() < deadline and (
+        heard["health_diagnosis"] < len(ticks["ticks"]) or not heard["diagnostics"]
+    ):
         rclpy.spin_once(node, timeout_sec=0.05)
     with open(out, "w") as f:
         json.dump({"published": len(ticks["ticks"]), **heard}, f)
