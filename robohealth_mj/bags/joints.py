@@ -5,19 +5,26 @@ name in whatever order the message lists them."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import cache
 
-from omegaconf import ListConfig, OmegaConf
+from omegaconf import DictConfig, ListConfig, OmegaConf
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.resources import conf_dir
 from robohealth_mj.schema import JOINT_NAMES, N_JOINTS
 
 
+@cache
+def _presets() -> DictConfig:
+    """``conf/joint_names.yaml``, read once (a monitor asks for it once per arm)."""
+    return OmegaConf.load(conf_dir() / "joint_names.yaml")
+
+
 def joint_names(names: str | Sequence[str] = "schema", prefix: str = "") -> tuple[str, ...]:
     """The six names, base to tool, of a preset in ``conf/joint_names.yaml`` or of a list,
     each with ``prefix`` before it; a bad value is one line naming ``ros2.joint_names``."""
     if isinstance(names, str):
-        presets = OmegaConf.load(conf_dir() / "joint_names.yaml")
+        presets = _presets()
         if names not in presets:
             raise InputError(
                 f"ros2.joint_names: unknown preset {names!r} (presets: {', '.join(presets)}; "

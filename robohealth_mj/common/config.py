@@ -53,18 +53,19 @@ def load_cli_config(
         cfg[key] = OmegaConf.load(conf_dir() / f"{key}.yaml")
     keys = [a.split("=", 1)[0] for a in argv]
     unknown = [k for k in keys if k.split(".")[0] not in cfg]
-    name = prog.rsplit(".", 1)[-1]
+    tool = prog.rsplit(".", 1)[-1]
     if unknown or any("=" not in a for a in argv):
-        raise SystemExit(report(name, InputError(
+        raise SystemExit(report(tool, InputError(
             f"usage: python -m {prog} key=value ... (keys: {', '.join(cfg)}); "
             f"not understood: {unknown or list(argv)}"
         )))  # fmt: skip
-    for arg in argv:  # each value is read as YAML: say which one it cannot read
+    given = []
+    for arg in argv:  # each value is read as YAML, one by one: say which one it cannot read
         try:
-            OmegaConf.from_dotlist([arg])
+            given.append(OmegaConf.from_dotlist([arg]))
         except Exception as exc:  # YAML's and OmegaConf's own parse errors
-            raise SystemExit(report(name, InputError(
+            raise SystemExit(report(tool, InputError(
                 f"{arg}: not a value ({type(exc).__name__}); quote text that holds braces or "
                 "a colon, e.g. key='\"{arm}_\"'"
             ))) from None  # fmt: skip
-    return OmegaConf.merge(cfg, OmegaConf.from_dotlist(list(argv)))
+    return OmegaConf.merge(cfg, *given)

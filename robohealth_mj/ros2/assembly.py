@@ -146,9 +146,9 @@ class ArmAssembler:
     def _settle(self, stamp: int, slot: dict[str, Any]) -> None:
         del self.pending[stamp]
         self.last_emitted = stamp
-        self.settled[stamp] = slot
-        while len(self.settled) > self.settled_kept:
-            del self.settled[min(self.settled)]
+        self.settled[stamp] = slot  # stamps settle in rising order: the first key is the oldest
+        if len(self.settled) > self.settled_kept:
+            del self.settled[next(iter(self.settled))]
 
     def _stamped_in(self, slot: dict[str, Any]) -> bool:
         return all(t in slot for t in self.stamped)
