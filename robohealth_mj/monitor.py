@@ -60,8 +60,13 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
     )  # fmt: skip
     if cfg.source != "ros2":
         return monitor_stream(cfg, runtime, policy, evidence)
-    if cfg.model and cfg.ros2.layout == "joints":  # a stock arm's topics: joint channels only
-        refuse_lacking_data(cfg.model, "stock", "ros2.layout=joints")
+    from robohealth_mj.ros2 import LAYOUT_SENSING
+
+    layout = cfg.ros2.layout
+    if layout not in LAYOUT_SENSING:
+        raise InputError(f"ros2.layout must be one of {list(LAYOUT_SENSING)}, got {layout!r}")
+    if cfg.model:  # the layout's topics carry these channels: a model reading more is refused
+        refuse_lacking_data(cfg.model, LAYOUT_SENSING[layout], f"ros2.layout={layout}")
     from robohealth_mj.ros2.live import monitor_arms
 
     return monitor_arms(cfg, runtime, policy, evidence)

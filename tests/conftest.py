@@ -23,7 +23,7 @@ from robohealth_mj.sim.model import build_model
 
 # Tests that read a model trained for the session are ``slow`` (so are those that train in their
 # own body, marked where they are): ``pytest -m "not slow"`` is the quick loop while developing.
-TRAINED_FIXTURES = frozenset({"deployed", "stock_deployed"})
+TRAINED_FIXTURES = frozenset({"deployed", "stock_deployed", "joint_states_deployed"})
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
@@ -179,12 +179,12 @@ def deployed(tmp_path_factory, learnable_corpus) -> dict[str, Path]:
     return {key: Path(value) for key, value in paths.items()}
 
 
-def _train_stock(corpus: Path, root: Path) -> dict:
+def _train_stock(corpus: Path, root: Path, sensing: str = "stock") -> dict:
     from robohealth_mj.deploy.export import export_checkpoint
     from robohealth_mj.learn.run import train_and_evaluate as run
 
     cfg = _tiny_train_config(
-        corpus, "trainer.epochs=1", "sensing=stock", "variant=stgnn_fixed", "model.hidden=8"
+        corpus, "trainer.epochs=1", f"sensing={sensing}", "variant=stgnn_fixed", "model.hidden=8"
     )
     run(cfg, root / "run")
     onnx = export_checkpoint(root / "run" / "best.ckpt", root / "model.onnx")["path"]
@@ -197,4 +197,13 @@ def stock_deployed(tmp_path_factory, tiny_corpus) -> dict[str, Path]:
     """A ``stgnn_fixed`` trained (1 epoch) with ``sensing=stock`` and exported, and its
     held-out data (``tiny_corpus``, which has every fault class)."""
     paths = cached(tmp_path_factory, "stock", lambda root: _train_stock(tiny_corpus, root))
+    return {key: Path(value) for key, value in paths.items()}
+
+
+@pytest.fixture(scope="session")
+def joint_states_deployed(tmp_path_factory, tiny_corpus) -> dict[str, Path]:
+    """As ``stock_deployed``, with the reduced ``sensing=joint_states`` profile: what any ROS 2
+    arm driver's ``/joint_states`` carries (the live UR driver tests' model)."""
+    paths = cached(tmp_path_factory, "joint_states",
+                   lambda root: _train_stock(tiny_corpus, root, "joint_states"))  # fmt: skip
     return {key: Path(value) for key, value in paths.items()}

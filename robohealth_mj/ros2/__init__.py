@@ -12,6 +12,15 @@ from __future__ import annotations
 
 from robohealth_mj.common.errors import InputError
 
+# The sensing profile (conf/sensing/) each live layout's topics deliver: a model may read those
+# channels or fewer (the monitor refuses one that reads more, in one line).
+LAYOUT_SENSING = {
+    "per_sensor": "full",  # the bag's topics: every channel
+    "aggregated": "full",  # the snapshot in one array
+    "joints": "stock",  # a stock arm's joint state and tracking error (this project's topics)
+    "ur_driver": "ur_driver",  # the UR driver's own: no torque residual
+}
+
 
 def require_dds() -> None:
     """Import the DDS binding or fail with one line saying how to install it."""

@@ -44,7 +44,7 @@ class Assembled:
     late: int = 0  # messages for ticks already reported missing, dropped
 
 
-def _stamp_ns(msg: Any) -> int | None:
+def header_stamp_ns(msg: Any) -> int | None:
     header = getattr(msg, "header", None)
     return None if header is None else int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
 
@@ -99,7 +99,7 @@ class ArmAssembler:
             self.queues[topic].append(msg)
         else:
             headerless = topic in self.queues or topic == self.aggregated
-            stamp = array_stamp_ns(msg) if headerless else _stamp_ns(msg)
+            stamp = array_stamp_ns(msg) if headerless else header_stamp_ns(msg)
             if stamp is None:
                 out.problems.append(f"topic '{topic}': message without a header stamp")
                 return out

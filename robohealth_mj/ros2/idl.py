@@ -126,6 +126,100 @@ class DiagnosticArray(IdlStruct, typename="diagnostic_msgs::msg::dds_::Diagnosti
     status: sequence[DiagnosticStatus] = field(default_factory=list)
 
 
+@dataclass
+@annotate.final
+class Duration(IdlStruct, typename="builtin_interfaces::msg::dds_::Duration_"):
+    sec: int32 = 0
+    nanosec: uint32 = 0
+
+
+@dataclass
+@annotate.final
+class JointTrajectoryPoint(IdlStruct, typename="trajectory_msgs::msg::dds_::JointTrajectoryPoint_"):
+    positions: sequence[float64] = field(default_factory=list)
+    velocities: sequence[float64] = field(default_factory=list)
+    accelerations: sequence[float64] = field(default_factory=list)
+    effort: sequence[float64] = field(default_factory=list)
+    time_from_start: Duration = field(default_factory=Duration)
+
+
+@dataclass
+@annotate.final
+class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
+    translation: Vector3 = field(default_factory=Vector3)
+    rotation: Quaternion = field(default_factory=Quaternion)
+
+
+@dataclass
+@annotate.final
+class Twist(IdlStruct, typename="geometry_msgs::msg::dds_::Twist_"):
+    linear: Vector3 = field(default_factory=Vector3)
+    angular: Vector3 = field(default_factory=Vector3)
+
+
+@dataclass
+@annotate.final
+class MultiDOFJointTrajectoryPoint(
+    IdlStruct, typename="trajectory_msgs::msg::dds_::MultiDOFJointTrajectoryPoint_"
+):
+    transforms: sequence[Transform] = field(default_factory=list)
+    velocities: sequence[Twist] = field(default_factory=list)
+    accelerations: sequence[Twist] = field(default_factory=list)
+    time_from_start: Duration = field(default_factory=Duration)
+
+
+MultiDOFPoint = MultiDOFJointTrajectoryPoint
+
+# control_msgs/msg/JointTrajectoryControllerState, what a joint trajectory controller (the UR
+# driver's scaled_joint_trajectory_controller) publishes on ~/controller_state. One DDS type name,
+# two layouts: Humble's control_msgs 4.x keeps the deprecated desired/actual after the new fields;
+# Jazzy's (5.3 on), Kilted's and Rolling's drop them and end with the speed scaling factor.
+_STATE = "control_msgs::msg::dds_::JointTrajectoryControllerState_"
+
+
+@dataclass
+@annotate.final
+class HumbleControllerState(IdlStruct, typename=_STATE):
+    header: Header = field(default_factory=Header)
+    joint_names: sequence[str] = field(default_factory=list)
+    reference: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    feedback: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    error: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    output: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    desired: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    actual: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    multi_dof_joint_names: sequence[str] = field(default_factory=list)
+    multi_dof_reference: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+    multi_dof_feedback: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+    multi_dof_error: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+    multi_dof_output: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+    multi_dof_desired: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+    multi_dof_actual: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+
+
+@dataclass
+@annotate.final
+class JazzyControllerState(IdlStruct, typename=_STATE):
+    header: Header = field(default_factory=Header)
+    joint_names: sequence[str] = field(default_factory=list)
+    reference: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    feedback: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    error: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    output: JointTrajectoryPoint = field(default_factory=JointTrajectoryPoint)
+    multi_dof_joint_names: sequence[str] = field(default_factory=list)
+    multi_dof_reference: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+    multi_dof_feedback: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+    multi_dof_error: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+    multi_dof_output: MultiDOFPoint = field(default_factory=MultiDOFPoint)
+    speed_scaling_factor: float64 = 1.0
+
+
+CONTROLLER_STATES: dict[str, type] = {
+    "humble": HumbleControllerState,
+    "jazzy": JazzyControllerState,
+}
+
+
 TYPES: dict[str, type] = {
     "builtin_interfaces/msg/Time": Time,
     "std_msgs/msg/Header": Header,
@@ -139,6 +233,8 @@ TYPES: dict[str, type] = {
     "diagnostic_msgs/msg/KeyValue": KeyValue,
     "diagnostic_msgs/msg/DiagnosticStatus": DiagnosticStatus,
     "diagnostic_msgs/msg/DiagnosticArray": DiagnosticArray,
+    "builtin_interfaces/msg/Duration": Duration,
+    "trajectory_msgs/msg/JointTrajectoryPoint": JointTrajectoryPoint,
 }
 
 

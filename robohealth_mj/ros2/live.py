@@ -33,6 +33,41 @@ def bus_config(cfg: DictConfig) -> Any:
     )
 
 
+def layout_options(cfg: DictConfig, tracking: bool = True) -> dict[str, Any]:
+    """The arm-side settings of ``conf/ros2.yaml`` as keyword arguments of ``MonitorNode`` and
+    ``ArmPublisher``: layout, namespace, joint names and, for ``ur_driver``, the driver's side
+    (``tracking``: the model reads ``pos_error``, so the controller state is awaited)."""
+    from robohealth_mj.ros2.driver import DriverConfig
+
+    layout = str(cfg.layout)
+    names = cfg.get("joint_names", "auto")
+    if names == "auto":
+        names = "ur_driver" if layout == "ur_driver" else "schema"
+    scale = cfg.get("effort_scale")
+    driver = DriverConfig(
+        controller_state=str(cfg.get("controller_state", DriverConfig.controller_state)),
+        distro=str(cfg.get("distro", DriverConfig.distro)),
+        tracking=tracking,
+        tick_hz=float(cfg.get("tick_hz", DriverConfig.tick_hz)),
+        timeout_s=float(cfg.get("controller_timeout_s", DriverConfig.timeout_s)),
+        effort_scale=None if scale is None else tuple(float(v) for v in scale),
+    )
+    return {"layout": layout, "namespace": str(cfg.get("namespace", "/{arm}")),
+            "joint_names": names, "tf_prefix": str(cfg.get("tf_prefix") or ""),
+            "driver": driver}  # fmt: skip
+
+
+def reads_tracking_error(model: str | None) -> bool:
+    """Whether the exported model reads ``pos_error`` (then a UR driver's controller state is
+    awaited for every tick); without a model, nothing is awaited."""
+    if not model:
+        return False
+    from robohealth_mj.data.sensing import load_profile
+    from robohealth_mj.runtime.metadata import read_metadata
+
+    return "pos_error" in load_profile(read_metadata(model).get("sensing", "full")).joint_channels
+
+
 @contextmanager
 def stop_on_signals() -> Iterator[threading.Event]:
     """An event set by SIGINT or SIGTERM while the block runs (handlers restored after)."""
@@ -60,9 +95,11 @@ def run_monitor(
     runtime: Any,
     duration_s: float | None,
     on_diagnosis: Callable[[str, GraphSample, Any], None] | None = None,
+    tracking: bool = True,
 ) -> dict[str, Any]:
     """Diagnose the configured arms until the duration ends or a signal comes; each diagnosis
-    also goes to ``on_diagnosis(arm, sample, diagnosis)`` (the on-line evaluation)."""
+    also goes to ``on_diagnosis(arm, sample, diagnosis)`` (the on-line evaluation);
+    ``tracking``: the model reads the tracking error (``ur_driver``: await the controller)."""
     require_dds()
     from robohealth_mj.ros2.bus import Bus
     from robohealth_mj.ros2.node import MonitorNode
@@ -73,8 +110,7 @@ def run_monitor(
     bus = Bus(bus_config(cfg))
     node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
                        stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
-                       layout=str(cfg.layout), joint_names=cfg.get("joint_names", "schema"),
-                       tf_prefix=str(cfg.get("tf_prefix") or ""))  # fmt: skip
+                       **layout_options(cfg, tracking))  # fmt: skip
     started = time.monotonic()
     last_report = started
     print(f"ros2 monitor: {len(arms)} arms on domain {cfg.domain_id} ({', '.join(arms[:5])}"
@@ -115,7 +151,7 @@ def run_robot(cfg: DictConfig, stream: Iterator[tuple[float, GraphSample]]) -> i
     from robohealth_mj.ros2.node import ArmPublisher
 
     bus = Bus(bus_config(cfg.ros2))
-    arms = [ArmPublisher(bus, arm, layout=str(cfg.ros2.layout)) for arm in arm_names(cfg.ros2)]
+    arms = [ArmPublisher(bus, arm, **layout_options(cfg.ros2)) for arm in arm_names(cfg.ros2)]
     time.sleep(float(cfg.discovery_s))  # let subscribers match before the first sample
     ticks, started, t0 = 0, time.perf_counter(), None
     with stop_on_signals() as stop:
@@ -149,7 +185,8 @@ def monitor_arms(cfg: DictConfig, runtime: Any, policy: Any, evidence: Any) -> d
         evaluators[arm].update(sample.fault, d, *joint_activity(sample.x))
 
     counts = run_monitor(cfg.ros2, runtime, cfg.duration_s or None,
-                         evaluate if cfg.evaluate else None)  # fmt: skip
+                         evaluate if cfg.evaluate else None,
+                         reads_tracking_error(cfg.model))  # fmt: skip
     for arm, c in counts.items():
         last = f" (last: {c['last_problem']})" if c["last_problem"] else ""
         print(f"{arm}: {c['samples']} samples diagnosed, {c['problems']} bad inputs, "

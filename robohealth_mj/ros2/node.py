@@ -18,19 +18,36 @@ from typing import Any
 from robohealth_mj.bags.joints import joint_names as arm_joint_names
 from robohealth_mj.bags.messages import MessageFactory
 from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.ros2 import LAYOUT_SENSING
 from robohealth_mj.ros2.assembly import ArmAssembler
 from robohealth_mj.ros2.bus import Bus
-from robohealth_mj.ros2.idl import TYPES, IdlStore
+from robohealth_mj.ros2.driver import DriverAssembler, DriverConfig, DriverMessages
+from robohealth_mj.ros2.idl import CONTROLLER_STATES, TYPES, IdlStore
 from robohealth_mj.schema import GraphSample
 
 DIAGNOSTICS_TOPIC = "/diagnostics"
+# What a requested-incompatible-QoS status's last policy id (DDS's QosPolicyId_t) means here.
+INCOMPATIBLE = {
+    2: "durability: the writer offers less than the reader asks",
+    11: "reliability: a best-effort writer and a reliable reader (ros2.reliable_subscriptions)",
+    24: "another message type, or another layout of it (a ROS distribution's: ros2.distro)",
+    25: "data representation (XCDR2 writer, XCDR1 reader)",
+}
 
 
-def arm_topics(arm: str, topics: BagTopics | None = None) -> BagTopics:
-    """The bag layout's topic names under the arm's namespace (``/arm1/joint_states`` …)."""
+def arm_topics(arm: str, topics: BagTopics | None = None, namespace: str = "/{arm}") -> BagTopics:
+    """The bag layout's topic names under the arm's namespace (``/arm1/joint_states`` …;
+    ``namespace=""``: at the root, as a single driver launched without one publishes)."""
     base = topics or BagTopics.load()
-    fields = {k: f"/{arm}/{v.lstrip('/')}" for k, v in vars(base).items()}
+    fields = {k: in_namespace(arm, v, namespace) for k, v in vars(base).items()}
     return replace(base, **fields)
+
+
+def in_namespace(arm: str, topic: str, namespace: str = "/{arm}") -> str:
+    """``topic`` under the arm's namespace (``{arm}`` in ``namespace`` is its name)."""
+    prefix = namespace.format(arm=arm).strip("/")
+    return f"/{prefix}/{topic.lstrip('/')}" if prefix else f"/{topic.lstrip('/')}"
 
 
 def in_partition(arm: str, partition: str | None) -> bool:
@@ -44,16 +61,17 @@ def in_partition(arm: str, partition: str | None) -> bool:
     return zlib.crc32(arm.encode()) % n == k
 
 
-LAYOUTS = ("per_sensor", "aggregated", "joints")
+LAYOUTS = tuple(LAYOUT_SENSING)
 
 
 def layout_topics(topics: BagTopics, layout: str) -> dict[str, str]:
     """The topics (-> message type) one sample travels on in ``layout``: ``per_sensor`` (the bag
     layout, 15 messages a tick), ``aggregated`` (the snapshot in one array, and the truth) or
     ``joints`` (a stock arm's own: joint state and tracking error, and the truth where there is
-    one; no sensor package, so those channels stay zero)."""
+    one; no sensor package, so those channels stay zero). ``ur_driver``'s topics are the
+    driver's (:func:`driver_topics`)."""
     if layout not in LAYOUTS:
-        raise ValueError(f"ros2.layout must be one of {LAYOUTS}, got {layout!r}")
+        raise InputError(f"ros2.layout must be one of {LAYOUTS}, got {layout!r}")
     if layout == "aggregated":
         return topics.aggregated_topics()
     every = topics.sample_topics()
@@ -63,22 +81,50 @@ def layout_topics(topics: BagTopics, layout: str) -> dict[str, str]:
     return every
 
 
+def driver_topics(topics: BagTopics, arm: str, driver: DriverConfig, namespace: str) -> dict:
+    """The UR driver's topics of one arm -> their message classes: ``joint_states`` and the
+    trajectory controller's state in the configured distribution's layout."""
+    if driver.distro not in CONTROLLER_STATES:
+        raise InputError(f"ros2.distro must be one of {list(CONTROLLER_STATES)}, got "
+                         f"{driver.distro!r}")  # fmt: skip
+    return {
+        topics.joint_states: TYPES["sensor_msgs/msg/JointState"],
+        in_namespace(arm, driver.controller_state, namespace): CONTROLLER_STATES[driver.distro],
+    }
+
+
 class ArmPublisher:
     """One simulated or replayed arm publishing its samples as a robot driver would."""
 
     def __init__(
-        self, bus: Bus, arm: str, topics: BagTopics | None = None, layout: str = "per_sensor"
+        self,
+        bus: Bus,
+        arm: str,
+        topics: BagTopics | None = None,
+        layout: str = "per_sensor",
+        namespace: str = "/{arm}",
+        driver: DriverConfig | None = None,
+        joint_names: str | Sequence[str] = "ur_driver",
+        tf_prefix: str = "",
     ) -> None:
-        self.arm, self.topics, self.layout = arm, arm_topics(arm, topics), layout
+        """``layout="ur_driver"``: as the UR driver publishes, with ``joint_names`` (and the
+        ``tf_prefix``) in its alphabetical order and the controller state of ``driver.distro``."""
+        self.arm, self.layout = arm, layout
+        self.topics = arm_topics(arm, topics, namespace)
         self.factory = MessageFactory(IdlStore())
-        self.writers = {
-            name: bus.writer(name, TYPES[kind])
-            for name, kind in layout_topics(self.topics, layout).items()
-        }
+        if layout == "ur_driver":
+            self.driver = DriverMessages(arm_joint_names(joint_names, tf_prefix.format(arm=arm)),
+                                         driver or DriverConfig())  # fmt: skip
+            kinds = driver_topics(self.topics, arm, self.driver.config, namespace)
+        else:
+            kinds = {t: TYPES[k] for t, k in layout_topics(self.topics, layout).items()}
+        self.writers = {name: bus.writer(name, cls) for name, cls in kinds.items()}
 
     def messages(self, sample: GraphSample, topics: BagTopics | None = None) -> list[tuple]:
         """``(topic, message)`` of one sample in this arm's layout (``topics``: other names)."""
         topics = topics or self.topics
+        if self.layout == "ur_driver":
+            return list(zip(self.writers, self.driver.messages(sample), strict=True))
         if self.layout == "aggregated":
             return [
                 (topics.aggregated, self.factory.aggregated(sample)),
@@ -105,7 +151,7 @@ class ArmPublisher:
 class ArmState:
     """What ``/diagnostics`` says of one arm."""
 
-    assembler: ArmAssembler
+    assembler: ArmAssembler | DriverAssembler
     readers: list[tuple[str, type, Any]]  # (topic, message class, reader)
     last_sample_wall: float | None = None
     last_diagnosis: Any = None
@@ -134,9 +180,12 @@ class MonitorNode:
         layout: str = "per_sensor",
         joint_names: str | Sequence[str] = "schema",
         tf_prefix: str = "",
+        namespace: str = "/{arm}",
+        driver: DriverConfig | None = None,
     ) -> None:
         """``joint_names`` (a preset of ``conf/joint_names.yaml`` or six names) and ``tf_prefix``
-        (``{arm}`` is the arm's name) say what each arm's JointState messages call its joints."""
+        (``{arm}`` is the arm's name) say what each arm's JointState messages call its joints;
+        ``namespace`` where its topics live; ``driver`` the UR driver's side (``ur_driver``)."""
         self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
         self.keep_diagnoses, self.on_diagnosis = keep_diagnoses, on_diagnosis
         # where the monitor's time goes (the benchmark reports it): take (DDS read and CDR
@@ -150,17 +199,19 @@ class MonitorNode:
         self.reported: list[tuple[str, str]] = []  # (arm, problem) of the last /diagnostics
         self.diagnosis_writers: dict[str, Any] = {}
         for arm in arms:
-            names = arm_topics(arm, topics)
-            kinds = layout_topics(names, layout)
-            aggregated = names.aggregated if layout == "aggregated" else None
+            names = arm_topics(arm, topics, namespace)
             joints = arm_joint_names(joint_names, tf_prefix.format(arm=arm))
-            assembler = ArmAssembler(arm, names, require_truth=require_truth,
-                                     aggregated=aggregated, sensors=layout != "joints",
-                                     joints=joints)  # fmt: skip
-            readers = [
-                (t, TYPES[kinds[t]], bus.reader(t, TYPES[kinds[t]]))
-                for t in assembler.topic_names()
-            ]
+            if layout == "ur_driver":
+                driver = driver or DriverConfig()
+                kinds = driver_topics(names, arm, driver, namespace)
+                assembler = DriverAssembler(arm, *kinds, joints, driver)
+            else:
+                kinds = {t: TYPES[k] for t, k in layout_topics(names, layout).items()}
+                aggregated = names.aggregated if layout == "aggregated" else None
+                assembler = ArmAssembler(arm, names, require_truth=require_truth,
+                                         aggregated=aggregated, sensors=layout != "joints",
+                                         joints=joints)  # fmt: skip
+            readers = [(t, kinds[t], bus.reader(t, kinds[t])) for t in assembler.topic_names()]
             self.arms[arm] = ArmState(assembler, readers)
             self.diagnosis_writers[arm] = bus.writer(names.health_diagnosis, TYPES[
                 "diagnostic_msgs/msg/DiagnosticArray"])  # fmt: skip
@@ -265,9 +316,10 @@ class MonitorNode:
             for topic, kind, reader in state.readers:
                 status = reader.get_requested_incompatible_qos_status()
                 if status.total_count_change:
+                    cause = INCOMPATIBLE.get(status.last_policy_id, "QoS")
                     state.problem = state.last_problem = (
                         f"topic '{topic}': a writer that cannot match a {kind.__name__} reader "
-                        f"(wrong type or QoS; policy id {status.last_policy_id})"
+                        f"({cause}; DDS policy id {status.last_policy_id})"
                     )
                     state.problems += 1
 

@@ -1,9 +1,10 @@
 """The other end of the interop test (``test_interop.py``), run by the ROS 2 wheels' own Python:
-a real rclpy node on Fast DDS that publishes what a UR ROS 2 driver does (``/<arm>/joint_states``
-with the driver's joint names in its alphabetical order, and the tracking error) at 20 Hz, and
-listens to the monitor's ``/diagnostics`` and ``/<arm>/health_diagnosis``.
+a real rclpy node on Fast DDS that publishes what the UR ROS 2 driver does for each arm
+(``/<arm>/joint_states`` with the driver's joint names, its tf_prefix and its alphabetical order)
+at 20 Hz, and listens to the monitor's ``/diagnostics`` and ``/<arm>/health_diagnosis``. It
+writes what it heard and each diagnosis's latency (received minus published, by stamp).
 
-    python ur_driver_node.py TICKS.json ARM OUT.json
+    python ur_driver_node.py TICKS.json OUT.json ARM [ARM ...]
 """
 
 from __future__ import annotations
@@ -21,51 +22,61 @@ from sensor_msgs.msg import JointState
 def main() -> None:
     with open(sys.argv[1]) as f:
         ticks = json.load(f)
-    arm, out = sys.argv[2], sys.argv[3]
+    out, arms = sys.argv[2], sys.argv[3:]
     rclpy.init()
     node = Node("ur_driver_stand_in")
-    states = node.create_publisher(JointState, f"/{arm}/joint_states", 10)
-    errors = node.create_publisher(JointState, f"/{arm}/joint_tracking_error", 10)
-    heard = {"diagnostics": 0, "health_diagnosis": 0}
+    heard = {"diagnostics": 0, **{arm: 0 for arm in arms}}
+    sent: dict[tuple[str, int], float] = {}  # (arm, stamp ns) -> when published
+    latency_ms: list[float] = []
 
-    def count(key: str):
-        return lambda _msg: heard.__setitem__(key, heard[key] + 1)
+    def diagnosis(arm: str):
+        def on(msg: DiagnosticArray) -> None:
+            now = time.monotonic()
+            heard[arm] += 1
+            stamp = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+            if (arm, stamp) in sent:
+                latency_ms.append((now - sent[arm, stamp]) * 1e3)
 
-    node.create_subscription(DiagnosticArray, "/diagnostics", count("diagnostics"), 10)
-    diagnoses = node.create_subscription(DiagnosticArray, f"/{arm}/health_diagnosis",
-                                         count("health_diagnosis"), 100)  # fmt: skip
+        return on
+
+    def count(_msg: DiagnosticArray) -> None:
+        heard["diagnostics"] += 1
+
+    node.create_subscription(DiagnosticArray, "/diagnostics", count, 10)
+    states = {arm: node.create_publisher(JointState, f"/{arm}/joint_states", 10) for arm in arms}
+    diagnoses = [node.create_subscription(DiagnosticArray, f"/{arm}/health_diagnosis",
+                                          diagnosis(arm), 100) for arm in arms]  # fmt: skip
     deadline = time.monotonic() + 60.0  # discovery: until the monitor is matched both ways
     while time.monotonic() < deadline and not (
-        states.get_subscription_count()
-        and errors.get_subscription_count()
-        and diagnoses.get_publisher_count()
+        all(p.get_subscription_count() for p in states.values())
+        and all(d.get_publisher_count() for d in diagnoses)
     ):
         rclpy.spin_once(node, timeout_sec=0.05)
     settled = time.monotonic() + 2.0  # our side has matched; give the monitor's readers
     while time.monotonic() < settled:  # time to match ours, or the first ticks go to nobody
         rclpy.spin_once(node, timeout_sec=0.05)
-    for tick in ticks["ticks"]:
-        for publisher, fields in ((states, ("position", "velocity", "effort")),
-                                  (errors, ("pos_error", "effort_residual"))):  # fmt: skip
+    start = time.monotonic()
+    for k, tick in enumerate(ticks["ticks"]):
+        for arm in arms:
             msg = JointState()
             msg.header.stamp.sec, msg.header.stamp.nanosec = tick["sec"], tick["nanosec"]
-            msg.name = ticks["names"]
-            msg.position = tick[fields[0]]
-            if publisher is states:
-                msg.velocity, msg.effort = tick["velocity"], tick["effort"]
-            else:
-                msg.effort = tick[fields[1]]
-            publisher.publish(msg)
-        deadline = time.monotonic() + 0.05
-        while time.monotonic() < deadline:
-            rclpy.spin_once(node, timeout_sec=0.01)
+            msg.name = [f"{arm}_{name}" for name in ticks["names"]]
+            msg.position, msg.velocity, msg.effort = (
+                tick["position"],
+                tick["velocity"],
+                tick["effort"],
+            )
+            sent[arm, tick["sec"] * 10**9 + tick["nanosec"]] = time.monotonic()
+            states[arm].publish(msg)
+        while time.monotonic() < start + (k + 1) * 0.05:  # 20 Hz, listening meanwhile
+            rclpy.spin_once(node, timeout_sec=0.005)
     deadline = time.monotonic() + 30.0  # every diagnosis back, and a /diagnostics period
     while time.monotonic() < deadline and (
-        heard["health_diagnosis"] < len(ticks["ticks"]) or not heard["diagnostics"]
+        min(heard[arm] for arm in arms) < len(ticks["ticks"]) or not heard["diagnostics"]
     ):
         rclpy.spin_once(node, timeout_sec=0.05)
     with open(out, "w") as f:
-        json.dump({"published": len(ticks["ticks"]), **heard}, f)
+        json.dump({"published": len(ticks["ticks"]), **heard, "latency_ms": latency_ms}, f)
     node.destroy_node()
     rclpy.shutdown()
 
