@@ -145,6 +145,11 @@ def test_driver_topics_at_500_hz_become_the_model_s_ticks_with_the_tracking_erro
     for a, b in zip(got, samples, strict=True):
         np.testing.assert_allclose(a.x, b.x, atol=1e-6)
         assert a.t == pytest.approx(b.t) and a.recording_run_id == "left"
+    # a controller publishing at 4 Hz: a tick more than 0.1 s after its last state has no
+    # tracking error it can trust and is dropped (the window restarts), the others keep theirs
+    slow = DriverAssembler("left", "/js", "/cs", UR, DriverConfig(tracking=True))
+    got, problems, _ = _run(slow, _driver_stream(samples, controller_hz=4))
+    assert problems == [] and [s.sample_index for s in got] == [0, 1, 2, 5, 6, 7, 10]  # 11 waits
 
 
 def test_without_the_controller_a_tracking_model_is_told_once_and_a_reduced_one_goes_on():
