@@ -29,7 +29,8 @@ from robohealth_mj.ros2.node import ArmPublisher, MonitorNode
 from robohealth_mj.runtime.runtime import ModelRuntime
 from robohealth_mj.schema import N_JOINTS, FaultLabel, GraphSample
 
-_DOMAINS = itertools.count(150 + os.getpid() % 40 * 2)
+# test_ros2.py takes domains 100-210: these stay below, so two modules never share one
+_DOMAINS = itertools.count(20 + os.getpid() % 35 * 2)
 UR = joint_names("ur_driver", "left_")  # the driver's names with a tf_prefix
 PERIOD_NS = 50_000_000  # 20 Hz ticks
 
