@@ -51,16 +51,34 @@ _POS, _VEL, _EFFORT, _POS_ERROR = (
 )
 
 
+# The ROS 2 distributions the UR driver supports -> the controller state's layout (idl.py).
+DISTROS = {"humble": "humble", "jazzy": "jazzy", "kilted": "jazzy", "rolling": "jazzy"}
+
+
 @dataclass(frozen=True)
 class DriverConfig:
     """The driver's side of ``conf/ros2.yaml`` (``ros2.layout=ur_driver``)."""
 
     controller_state: str = "scaled_joint_trajectory_controller/controller_state"
-    distro: str = "jazzy"  # the controller state's layout: humble, or jazzy (Jazzy on)
+    distro: str = "jazzy"  # the ROS 2 distribution: the controller state's layout
     tracking: bool = True  # the model reads pos_error: wait for the controller's state
     tick_hz: float = 20.0
     timeout_s: float = 0.5
     effort_scale: tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.distro not in DISTROS:
+            raise InputError(f"ros2.distro must be one of {list(DISTROS)}, got {self.distro!r}")
+        if self.tick_hz <= 0 or self.timeout_s <= 0:
+            raise InputError(
+                f"ros2.tick_hz and ros2.controller_timeout_s must be positive, got "
+                f"{self.tick_hz} and {self.timeout_s}"
+            )
+
+    @property
+    def layout(self) -> str:
+        """The controller state's field layout: ``humble`` or ``jazzy``."""
+        return DISTROS[self.distro]
 
 
 class _Problem(Exception):
@@ -232,7 +250,7 @@ class DriverMessages:
         self.config, self.joints = config, tuple(joints)
         self.order = sorted(range(N_JOINTS), key=lambda k: self.joints[k])
         self.names = [self.joints[k] for k in self.order]
-        self.State, self.Point = CONTROLLER_STATES[config.distro], JointTrajectoryPoint
+        self.State, self.Point = CONTROLLER_STATES[config.layout], JointTrajectoryPoint
         self.JointState = JointState
 
     def messages(self, sample: GraphSample) -> list[Any]:

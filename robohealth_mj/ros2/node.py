@@ -84,12 +84,9 @@ def layout_topics(topics: BagTopics, layout: str) -> dict[str, str]:
 def driver_topics(topics: BagTopics, arm: str, driver: DriverConfig, namespace: str) -> dict:
     """The UR driver's topics of one arm -> their message classes: ``joint_states`` and the
     trajectory controller's state in the configured distribution's layout."""
-    if driver.distro not in CONTROLLER_STATES:
-        raise InputError(f"ros2.distro must be one of {list(CONTROLLER_STATES)}, got "
-                         f"{driver.distro!r}")  # fmt: skip
     return {
         topics.joint_states: TYPES["sensor_msgs/msg/JointState"],
-        in_namespace(arm, driver.controller_state, namespace): CONTROLLER_STATES[driver.distro],
+        in_namespace(arm, driver.controller_state, namespace): CONTROLLER_STATES[driver.layout],
     }
 
 

@@ -306,6 +306,9 @@ def test_effort_scale_turns_the_driver_s_current_into_torque():
         np.testing.assert_allclose(a.x[:6, 4], b.x[:6, 4], rtol=1e-6)
     amperes = messages.messages(samples[0])[0].effort
     assert amperes[0] == pytest.approx(samples[0].x[2, 4] / 12.0)  # elbow_joint listed first
+    assert DriverConfig(distro="kilted").layout == DriverConfig(distro="rolling").layout == "jazzy"
+    with pytest.raises(ValueError, match=r"ros2\.distro must be one of \['humble', 'jazzy'"):
+        DriverConfig(distro="iron")  # end of life, and not a UR driver's
     with pytest.raises(ValueError, match=r"ros2\.effort_scale: six numbers"):
         DriverAssembler("left", "/js", "/cs", UR, dataclasses.replace(config, effort_scale=(1.0,)))
 
