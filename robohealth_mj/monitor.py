@@ -60,13 +60,11 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
     )  # fmt: skip
     if cfg.source != "ros2":
         return monitor_stream(cfg, runtime, policy, evidence)
-    from robohealth_mj.ros2 import LAYOUT_SENSING
+    from robohealth_mj.ros2 import layout_sensing
 
-    layout = cfg.ros2.layout
-    if layout not in LAYOUT_SENSING:
-        raise InputError(f"ros2.layout must be one of {list(LAYOUT_SENSING)}, got {layout!r}")
-    if cfg.model:  # the layout's topics carry these channels: a model reading more is refused
-        refuse_lacking_data(cfg.model, LAYOUT_SENSING[layout], f"ros2.layout={layout}")
+    delivered = layout_sensing(cfg.ros2.layout)  # the channels the layout's topics carry
+    if cfg.model:  # a model reading more is refused
+        refuse_lacking_data(cfg.model, delivered, f"ros2.layout={cfg.ros2.layout}")
     from robohealth_mj.ros2.live import monitor_arms
 
     return monitor_arms(cfg, runtime, policy, evidence)

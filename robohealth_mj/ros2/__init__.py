@@ -22,6 +22,13 @@ LAYOUT_SENSING = {
 }
 
 
+def layout_sensing(layout: str) -> str:
+    """The sensing profile ``ros2.layout``'s topics deliver; one line for an unknown layout."""
+    if layout not in LAYOUT_SENSING:
+        raise InputError(f"ros2.layout must be one of {list(LAYOUT_SENSING)}, got {layout!r}")
+    return LAYOUT_SENSING[layout]
+
+
 def require_dds() -> None:
     """Import the DDS binding or fail with one line saying how to install it."""
     try:

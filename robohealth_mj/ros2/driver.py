@@ -117,7 +117,6 @@ class DriverAssembler:
         self.errors: deque[tuple[int, np.ndarray]] = deque(maxlen=256)  # (stamp, pos_error [6])
         self.last_error: tuple[int, Any] | None = None
         self.silent = False  # the controller is reported silent until its state returns
-        self.dropped = 0  # ticks dropped while the controller was silent
 
     def topic_names(self) -> list[str]:
         return [self.joint_states, *([self.controller_state] if self.tracking else [])]
@@ -194,8 +193,7 @@ class DriverAssembler:
     def _tracking_error(self, stamp: int, msg: Any) -> None:
         (error,) = self._columns(msg, msg.joint_names, msg.error, ("positions",))
         self.errors.append((stamp, -error))
-        if self.silent:
-            self.silent = False
+        self.silent = False
 
     def _held_error(self, tick: int) -> np.ndarray | None:
         """The controller's tracking error at ``tick``: its last state at or before it."""
@@ -211,17 +209,14 @@ class DriverAssembler:
             if newest is not None and newest >= tick:  # nothing nearer can come
                 self.pending.popleft()
                 error = self._held_error(tick)
-                if error is None:
-                    self.dropped += 1
-                    continue
-                state[:, _POS_ERROR] = error
-                out.samples.append(self._sample(tick, state))
+                if error is not None:  # else too old to trust: the tick is dropped
+                    state[:, _POS_ERROR] = error
+                    out.samples.append(self._sample(tick, state))
                 continue
             heard = newest if newest is not None else self.origin
             if not settle or self.last_state[0] - heard <= self.timeout_ns:
                 return
             self.pending.popleft()  # the controller is silent: this tick has no tracking error
-            self.dropped += 1
             if not self.silent:
                 self.silent = True
                 out.problems.append(

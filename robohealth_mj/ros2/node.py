@@ -18,8 +18,7 @@ from typing import Any
 from robohealth_mj.bags.joints import joint_names as arm_joint_names
 from robohealth_mj.bags.messages import MessageFactory
 from robohealth_mj.bags.topics import BagTopics
-from robohealth_mj.common.errors import InputError
-from robohealth_mj.ros2 import LAYOUT_SENSING
+from robohealth_mj.ros2 import layout_sensing
 from robohealth_mj.ros2.assembly import ArmAssembler
 from robohealth_mj.ros2.bus import Bus
 from robohealth_mj.ros2.driver import DriverAssembler, DriverConfig, DriverMessages
@@ -61,17 +60,13 @@ def in_partition(arm: str, partition: str | None) -> bool:
     return zlib.crc32(arm.encode()) % n == k
 
 
-LAYOUTS = tuple(LAYOUT_SENSING)
-
-
 def layout_topics(topics: BagTopics, layout: str) -> dict[str, str]:
     """The topics (-> message type) one sample travels on in ``layout``: ``per_sensor`` (the bag
     layout, 15 messages a tick), ``aggregated`` (the snapshot in one array, and the truth) or
     ``joints`` (a stock arm's own: joint state and tracking error, and the truth where there is
     one; no sensor package, so those channels stay zero). ``ur_driver``'s topics are the
     driver's (:func:`driver_topics`)."""
-    if layout not in LAYOUTS:
-        raise InputError(f"ros2.layout must be one of {LAYOUTS}, got {layout!r}")
+    layout_sensing(layout)  # a known layout, or one line
     if layout == "aggregated":
         return topics.aggregated_topics()
     every = topics.sample_topics()
