@@ -17,7 +17,7 @@ from robohealth_mj.data.jsonl import read_jsonl_samples
 from robohealth_mj.logs import is_log, log_samples
 from robohealth_mj.schema import GraphSample
 
-__all__ = ["is_bag", "is_log", "read_samples", "recording_sensing"]
+__all__ = ["is_bag", "is_log", "read_samples", "recording_arm", "recording_sensing"]
 
 
 def recording_sensing(path: Path | str) -> str:
@@ -38,6 +38,21 @@ def recording_sensing(path: Path | str) -> str:
         except (ValueError, AttributeError):
             return "full"
     return "full"
+
+
+def recording_arm(path: Path | str) -> str | None:
+    """The arm a recording comes from, where its manifest says (``arm_ratings``: every recording
+    simulated since arms became data); ``None`` where nothing says (a log, a bag, an older one)."""
+    path = Path(path)
+    if is_log(path) or is_bag(path):
+        return None
+    manifest = (path if path.is_dir() else path.parent) / "manifest.json"
+    try:
+        ratings = json.loads(manifest.read_text()).get("arm_ratings") or {}
+    except (OSError, ValueError, AttributeError):
+        return None
+    arm = ratings.get("arm") if isinstance(ratings, dict) else None
+    return str(arm) if arm else None
 
 
 def read_samples(path: Path | str) -> Iterator[GraphSample]:

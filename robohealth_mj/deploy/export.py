@@ -254,6 +254,7 @@ def export_checkpoint(
         joint_scores=joint_score_kind(ckpt),
         sensing=graph.sensing,
         label_set=json.dumps(list(graph.classes)),
+        arms=json.dumps(list(ckpt.get("arms") or [])),
         **commissioning_metadata(ckpt),
         **incremental,
     )

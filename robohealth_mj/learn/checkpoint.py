@@ -166,16 +166,31 @@ def model_from_checkpoint(ckpt: dict[str, Any]) -> nn.Module:
     return model.eval()
 
 
+def training_arms(files: list) -> list[str]:
+    """The arms the recordings ``files`` say they come from (those that say), sorted."""
+    from robohealth_mj.data.read import recording_arm
+
+    return sorted({a for a in map(recording_arm, files) if a is not None})
+
+
 def check_recordings(ckpt: dict[str, Any], files: list) -> None:
-    """Refuse, in one line, a recording of another schema or one lacking channels the model reads
-    (its sensing profile's: a full model on a controller log, say)."""
-    from robohealth_mj.data.read import recording_sensing
+    """Refuse, in one line, a recording of another schema, one lacking channels the model reads
+    (its sensing profile's: a full model on a controller log, say), or one of an arm the model was
+    not trained on (its torques and speeds are on another scale)."""
+    from robohealth_mj.data.read import recording_arm, recording_sensing
     from robohealth_mj.data.sensing import refuse_missing_channels
 
     sensing = graph_from_checkpoint(ckpt).sensing
+    arms = list(ckpt.get("arms") or [])  # empty: trained on recordings that name no arm
     for f in files:
         check_schema(ckpt, str(f))
         refuse_missing_channels(sensing, recording_sensing(f), str(f))
+        arm = recording_arm(f)
+        if arms and arm is not None and arm not in arms:
+            raise InputError(
+                f"{f}: a recording of a {arm}; the model was trained on {', '.join(arms)} and "
+                f"reads no other arm (train one on {arm} recordings)"
+            )
 
 
 def check_schema(ckpt: dict[str, Any], source: str) -> None:

@@ -26,7 +26,7 @@ from robohealth_mj.common.version import code_version
 from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.data.graphs import GraphSpec, coupling_correlation
 from robohealth_mj.data.windows import make_windows, normalisation, run_aware_split
-from robohealth_mj.learn.checkpoint import save_checkpoint
+from robohealth_mj.learn.checkpoint import save_checkpoint, training_arms
 from robohealth_mj.learn.data import WindowTensors
 from robohealth_mj.learn.loss import loss_from_config
 from robohealth_mj.learn.metrics import metrics_of
@@ -154,7 +154,11 @@ def _save(p: Prepared, out_dir: Path, best_epoch: int, gamma: float | None) -> N
         code_version=code_version(),
         data_fingerprint=p.rec.fingerprint(),
         best_epoch=best_epoch,
-        extra={"gamma": gamma, "split_runs": split_runs(p)},
+        extra={
+            "gamma": gamma,
+            "split_runs": split_runs(p),
+            "arms": training_arms(expand_paths(cfg.data.train)),
+        },
     )
 
 

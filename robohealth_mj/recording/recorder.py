@@ -37,6 +37,7 @@ from robohealth_mj.schema import (
     SCHEMA_VERSION,
     FaultLabel,
 )
+from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 
 GRAPHS_FILE = "graphs.jsonl"
 MANIFEST_FILE = "manifest.json"
@@ -52,10 +53,13 @@ def default_run_id(cfg: DictConfig) -> str:
     """A run id fixed by what was simulated (same config, same id, same bytes)."""
     data = session_config(cfg)
     data["session"] = {k: v for k, v in data["session"].items() if k not in _IDENTITY_EXCLUDE}
-    if not any(v for k, v in data.get("arm", {}).items() if k != "_target_"):
-        data.pop("arm", None)  # the nominal arm, which every recording had before arm draws
     digest = hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:10]
-    return f"ur5e-s{cfg.seed}-{digest}"
+    return f"{arm_name(cfg)}-s{cfg.seed}-{digest}"
+
+
+def arm_name(cfg: DictConfig) -> str:
+    """The arm a record config simulates (``arm=varied`` alone: the default arm)."""
+    return str(cfg.arm.get("name", DEFAULT_ARM))
 
 
 @dataclass
@@ -143,12 +147,21 @@ def _stop_between_chunks():
 
 def build_simulator(cfg: DictConfig) -> ArmSimulator:
     """Instantiate model, curriculum, controller and sensors from the composed config."""
-    nominal = instantiate(cfg.sim)
     variation = instantiate(cfg.arm)
+    description = load_arm(variation.name)
+    nominal = instantiate(cfg.sim, arm=description.name)
     model, arm = variation.draw(nominal, cfg.seed)  # the physics: this session's arm
-    curriculum = instantiate(cfg.curriculum, seed=cfg.seed, _convert_="all")
+    curriculum = instantiate(
+        cfg.curriculum,
+        seed=cfg.seed,
+        rated_payload_kg=description.payload_kg,
+        speed_limit_rad_s=description.speed_limit.tolist(),
+        _convert_="all",
+    )
     controller = instantiate(cfg.control, model=nominal)  # the controller: the datasheet's
     sensors = instantiate(cfg.sensors, physics_rate_hz=1.0 / model.opt.timestep, _convert_="all")
+    # the drive's torque sensing resolves the same fraction of its rating on every arm
+    sensors.effort_scale = description.rated_torque / np.asarray(cfg.sim.reference_torque_nm)
     variation.apply_to_sensors(sensors, arm)
     tick_s = round(1.0 / (cfg.session.tick_hz * model.opt.timestep)) * model.opt.timestep
     schedule = instantiate(cfg.faults.schedule, tick_s=tick_s, seed=cfg.seed, _convert_="all")
@@ -167,6 +180,7 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
         faults=faults,
     )
     sim.arm = arm  # the drawn factors ({} for the nominal arm), for the manifest
+    sim.ratings = description.ratings()
     return sim
 
 
@@ -200,6 +214,7 @@ def record_session(cfg: DictConfig, out_dir: Path | str) -> RecordingResult:
         "expected_samples": n_ticks,
         "faults": sim.faults.describe(),
         "arm": sim.arm,
+        "arm_ratings": sim.ratings,
         "config": session_config(cfg),
     }
     atomic_write_json(out_dir / MANIFEST_FILE, manifest)

@@ -18,12 +18,13 @@ import numpy as np
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import N_JOINTS
+from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 
 FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place")
 WAVEFORMS = ("sine", "triangle", "compound")
 TASKS = ("pick_place", "palletise")  # the pick_place family's programs
 LEG_S = 0.8  # the shortest point-to-point move at speed scale 1, s
-JOINT_SPEED = 1.0  # rad/s: the fastest joint's peak speed in a move at speed scale 1
+JOINT_SPEED = 1.0  # rad/s: the fastest joint's peak speed in a move at speed scale 1 (a UR5e's)
 LIFT_RAD = (0.0, -0.25, 0.35, -0.1, 0.0, 0.0)  # from a pick or place pose to above it
 
 
@@ -84,7 +85,7 @@ class Curriculum:
         self,
         speed_scales: Sequence[float],
         payload_scales: Sequence[float],
-        nominal_payload_kg: float,
+        payload_fraction: float,
         base_frequency_hz: float,
         segment_s: float,
         blend_s: float,
@@ -96,7 +97,14 @@ class Curriculum:
         payload_ramp_s: float = 1.0,
         families: Sequence[str] = FAMILIES,
         seed: int = 0,
+        reference_speed_rad_s: float = np.pi,
+        rated_payload_kg: float | None = None,
+        speed_limit_rad_s: Sequence[float] | None = None,
     ) -> None:
+        """``payload_fraction`` of the arm's rated payload is the nominal payload the payload
+        scales multiply; ``amplitude_rad`` is for a joint whose speed limit is
+        ``reference_speed_rad_s``, and each joint's scales with its own limit over that, so every
+        arm moves at the same fraction of its limits (arm defaults: the UR5e's)."""
         if not speed_scales or not payload_scales:
             raise InputError("curriculum needs at least one speed scale and one payload scale")
         if segment_s < 2.0 * blend_s:
@@ -110,11 +118,19 @@ class Curriculum:
                 raise InputError(f"curriculum.{name} needs {N_JOINTS} values, got {len(vec)}")
         self.speed_scales = [float(s) for s in speed_scales]
         self.payload_scales = [float(p) for p in payload_scales]
-        self.nominal_payload_kg = float(nominal_payload_kg)
+        default = load_arm(DEFAULT_ARM)
+        rated = default.payload_kg if rated_payload_kg is None else float(rated_payload_kg)
+        limits = default.speed_limit if speed_limit_rad_s is None else speed_limit_rad_s
+        if not 0.0 < payload_fraction <= 1.0:
+            raise InputError(f"curriculum.payload_fraction: in (0, 1], got {payload_fraction}")
+        if len(limits) != N_JOINTS or not reference_speed_rad_s > 0:
+            raise InputError("curriculum: speed limits need one positive value per joint")
+        self.nominal_payload_kg = float(payload_fraction) * rated
+        self.speed_ratio = np.asarray(limits, dtype=float) / float(reference_speed_rad_s)
         self.base_frequency_hz = float(base_frequency_hz)
         self.segment_s = float(segment_s)
         self.blend_s = float(blend_s)
-        self.amplitude = np.asarray(amplitude_rad, dtype=float)
+        self.amplitude = np.asarray(amplitude_rad, dtype=float)  # scaled below, once limits known
         self.pair_factor = float(pair_amplitude_factor)
         self.whole_factor = float(whole_arm_amplitude_factor)
         self.jitter = np.asarray(center_jitter_rad, dtype=float)
@@ -122,6 +138,7 @@ class Curriculum:
         if not 0.0 <= payload_ramp_s <= blend_s:
             raise InputError(f"payload_ramp_s ({payload_ramp_s}) must be in [0, blend_s]")
         self.payload_ramp_s = float(payload_ramp_s)
+        self.amplitude = self.amplitude * self.speed_ratio
         unknown = sorted(set(families) - set(FAMILIES))
         if unknown or not families:
             raise InputError(f"curriculum.families must be a non-empty subset of {FAMILIES}")
@@ -195,8 +212,8 @@ class Curriculum:
         each move starts and stops at rest, so the reference stays C2)."""
         poses = self.waypoints(visit)
         speed = self.scheduled(visit).segment.speed_scale
-        # a quintic's peak speed is 1.875 x distance / duration
-        span = np.abs(np.diff(poses, axis=0)).max(axis=1)
+        # a quintic's peak speed is 1.875 x distance / duration (each joint's own share of it)
+        span = (np.abs(np.diff(poses, axis=0)) / self.speed_ratio).max(axis=1)
         legs = np.maximum(LEG_S, 1.875 * span / JOINT_SPEED) / speed
         legs *= min(1.0, 0.9 * self.segment_s / legs.sum())  # a program fits its segment
         dwell = (self.segment_s - legs.sum()) / (len(legs) + 1)

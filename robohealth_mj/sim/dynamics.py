@@ -8,16 +8,17 @@ from functools import lru_cache
 import mujoco
 import numpy as np
 
+from robohealth_mj.sim.arms import DEFAULT_ARM
 from robohealth_mj.sim.model import ArmIndex, build_model
 
 
-@lru_cache(maxsize=1)
-def _nominal() -> tuple[mujoco.MjModel, ArmIndex]:
-    model = build_model()
+@lru_cache(maxsize=8)
+def _nominal(arm: str) -> tuple[mujoco.MjModel, ArmIndex]:
+    model = build_model(arm)
     return model, ArmIndex.of(model)
 
 
-def gravity_torques(q: np.ndarray, payload_kg: float = 0.0) -> np.ndarray:
+def gravity_torques(q: np.ndarray, payload_kg: float = 0.0, arm: str = DEFAULT_ARM) -> np.ndarray:
     """Joint torques (N m, UR sign convention) that hold the arm still at pose ``q``.
 
     The payload is a point mass of ``payload_kg`` at the tool flange.
@@ -27,7 +28,7 @@ def gravity_torques(q: np.ndarray, payload_kg: float = 0.0) -> np.ndarray:
         raise ValueError(f"q must have shape (6,), got {q.shape}")
     if payload_kg < 0:
         raise ValueError(f"payload_kg must be >= 0, got {payload_kg}")
-    model, index = _nominal()
+    model, index = _nominal(arm)
     local = copy.copy(model)  # the cached nominal model is never edited
     local.body_mass[index.payload_body] = payload_kg
     data = mujoco.MjData(local)

@@ -1,67 +1,79 @@
-"""Building the MuJoCo model of the UR5e scene and naming its parts.
+"""Compiling an arm's MuJoCo model and naming its parts.
 
-The MJCF in ``assets/ur5e`` holds the nominal physics. Config edits (time step, drive parameters)
-are applied with dm-control's ``mjcf`` object model rather than by editing XML text, then the model
-is compiled with ``mujoco`` itself.
+The arm is data (``assets/<arm>/``, :mod:`robohealth_mj.sim.arms`); :mod:`robohealth_mj.sim.builder`
+turns it into MJCF with our drive model through dm-control's ``mjcf``, and ``mujoco`` compiles it.
 """
 
 from __future__ import annotations
 
-import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 
 import mujoco
 import numpy as np
+from omegaconf import OmegaConf
 
-with warnings.catch_warnings():
-    # dm-control probes for an OpenGL backend on import; model editing needs none.
-    warnings.simplefilter("ignore")
-    from dm_control import mjcf
-
-from robohealth_mj.common.resources import asset_dir
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.resources import asset_dir, conf_dir
 from robohealth_mj.schema import JOINT_NAMES
+from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
+from robohealth_mj.sim.builder import DRIVE_KEYS, HOME_POSE, DriveModel, build_arm_scene
 
 ASSET_DIR = asset_dir()
-SCENE_XML = ASSET_DIR / "ur5e" / "scene.xml"
-HOME_POSE = np.array([-np.pi / 2, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
+SCENE_XML = ASSET_DIR / "scene.xml"
+__all__ = ["HOME_POSE", "ArmIndex", "build_model", "default_drives"]
+
+
+@cache
+def default_drives() -> DriveModel:
+    """The drive model of the packaged ``conf/sim/default.yaml`` (one source of its numbers)."""
+    cfg = OmegaConf.load(conf_dir() / "sim" / "default.yaml")
+    return DriveModel(
+        OmegaConf.to_container(cfg.drives), tuple(float(v) for v in cfg.reference_torque_nm)
+    )
 
 
 def build_model(
-    timestep: float = 0.001, drive_overrides: dict | None = None, scene: Path | str = SCENE_XML
+    arm: str = DEFAULT_ARM,
+    timestep: float = 0.001,
+    drives: Mapping[str, Mapping[str, float]] | None = None,
+    reference_torque_nm: list[float] | None = None,
+    drive_overrides: dict | None = None,
+    scene: Path | str = SCENE_XML,
 ) -> mujoco.MjModel:
-    """Compile the scene, applying a physics time step and optional per-joint drive overrides.
+    """Compile arm ``arm`` in the scene at physics time step ``timestep``.
 
-    ``drive_overrides`` maps a joint name to any of ``armature``, ``damping``, ``frictionloss``
-    (motor side) and ``stiffness``, ``tendon_damping``, ``backlash`` (the drive tendon).
+    ``drives``/``reference_torque_nm``: the drive model stated for the UR5e (default: the packaged
+    config's); ``drive_overrides`` maps a joint name to any of ``armature``, ``damping``,
+    ``frictionloss`` (motor side) and ``stiffness``, ``tendon_damping``, ``backlash`` (the drive
+    tendon), set after scaling to the arm.
     """
     scene = Path(scene)
     if not scene.is_file():
         raise FileNotFoundError(f"scene file not found: {scene} (set ROBOHEALTH_ASSETS?)")
-    root = mjcf.from_path(str(scene))
-    root.option.timestep = float(timestep)
+    if not float(timestep) > 0:
+        raise InputError(f"sim.timestep: must be > 0, got {timestep}")
+    model = (
+        default_drives()
+        if drives is None
+        else DriveModel(drives, tuple(reference_torque_nm or default_drives().reference_torque_nm))
+    )
+    description = load_arm(str(arm))
+    per_joint = model.for_arm(description)
     for joint, params in (drive_overrides or {}).items():
-        _apply_drive_override(root, joint, dict(params))
+        if joint not in JOINT_NAMES:
+            raise KeyError(
+                f"drive override for unknown joint {joint!r}; known: {list(JOINT_NAMES)}"
+            )
+        unknown = sorted(set(params) - set(DRIVE_KEYS))
+        if unknown:
+            raise KeyError(f"unknown drive parameters for {joint}: {unknown}")
+        per_joint[joint].update({k: float(v) for k, v in params.items()})
+    root = build_arm_scene(description, per_joint, scene)
+    root.option.timestep = float(timestep)
     return mujoco.MjModel.from_xml_string(root.to_xml_string(), assets=root.get_assets())
-
-
-def _apply_drive_override(root: mjcf.RootElement, joint: str, params: dict) -> None:
-    if joint not in JOINT_NAMES:
-        raise KeyError(f"drive override for unknown joint {joint!r}; known: {list(JOINT_NAMES)}")
-    motor = root.find("joint", f"{joint}_joint")
-    tendon = root.find("tendon", f"{joint}_drive")
-    for key in ("armature", "damping", "frictionloss"):
-        if key in params:
-            setattr(motor, key, float(params.pop(key)))
-    if "stiffness" in params:
-        tendon.stiffness = float(params.pop("stiffness"))
-    if "tendon_damping" in params:
-        tendon.damping = float(params.pop("tendon_damping"))
-    if "backlash" in params:
-        half = float(params.pop("backlash"))
-        tendon.springlength = [-half, half]
-    if params:
-        raise KeyError(f"unknown drive parameters for {joint}: {sorted(params)}")
 
 
 @dataclass(frozen=True)

@@ -95,6 +95,8 @@ class SensorPackage:
         # this arm's own transducers (sim/variation.py): sensitivity and noise factor per joint
         self.gain = np.ones(N_JOINTS)
         self.noise_scale = np.ones(N_JOINTS)
+        # the torque sensing's floor per joint relative to the UR5e's (its rating over the UR5e's)
+        self.effort_scale = np.ones(N_JOINTS)
 
     def reset(self) -> None:
         for f in self.filters:
@@ -150,6 +152,6 @@ class SensorPackage:
         return (
             pos + rng.normal(0.0, n.pos, pos.shape),
             vel + rng.normal(0.0, n.vel, vel.shape),
-            effort + rng.normal(0.0, n.effort, effort.shape),
+            effort + rng.normal(0.0, n.effort, effort.shape) * self.effort_scale,
             acc + rng.normal(0.0, n.acc, acc.shape) * self.noise_scale[None, :, None],
         )

@@ -18,6 +18,7 @@ import numpy as np
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
+from robohealth_mj.sim.arms import DEFAULT_ARM, known_arms
 from robohealth_mj.sim.model import ArmIndex
 
 LINKS = ("shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link",
@@ -37,14 +38,19 @@ class ArmVariation:
     sensor_gain: float = 0.0  # each sensor package's sensitivity (accelerometer and piezo)
     sensor_noise: float = 0.0  # each sensor package's noise floor
     seed: int | None = None  # the arm's own seed (None: the session's), to run one arm twice
+    name: str = DEFAULT_ARM  # which arm (a folder of assets/) this session's copy is of
 
     def __post_init__(self) -> None:
+        if self.name not in known_arms():
+            raise InputError(
+                f"arm.name: unknown arm {self.name!r}; known: {', '.join(known_arms())}"
+            )
         for name, spread in self.spreads().items():
             if not 0.0 <= spread < 1.0:
                 raise InputError(f"arm.{name}: a spread in [0, 1), got {spread}")
 
     def spreads(self) -> dict[str, float]:
-        return {k: v for k, v in vars(self).items() if k != "seed"}
+        return {k: v for k, v in vars(self).items() if k not in ("seed", "name")}
 
     @property
     def nominal(self) -> bool:

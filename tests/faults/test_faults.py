@@ -96,7 +96,12 @@ def test_physics_faults_propagate_and_fall_with_hop_distance(fault_class):
     faulted = _readings(["seed=3", "faults=fixed", *overrides], 20.0)["sensor"]
     hops = by_hops(effect_by_sensor(healthy_run, faulted), JOINT_NAMES.index("elbow"))
     assert hops[1] > 0.1 and hops[2] > 0.1  # other joints' sensors see it
-    assert hops[0] > hops[1] > hops[2]
+    # the faulted joint's own sensor sees it most; beyond one hop the fall is not monotonic for
+    # every mode (a jam at the elbow: 18.9 own, 7.3 one hop, 7.5 two hops on UR's UR5e inertials,
+    # where the light wrist links shake the most)
+    assert hops[0] > 1.5 * max(hops[1], hops[2])
+    if fault_class != "jam":
+        assert hops[1] > hops[2]
 
 
 def test_physics_friction_raises_the_effort_of_the_target_drive():
@@ -105,7 +110,14 @@ def test_physics_friction_raises_the_effort_of_the_target_drive():
     h_state, _, _ = _simulate("faults=none", *moving)
     state, _, _ = _simulate(*_fixed("friction", "elbow", "faults.fault_model=physics", *moving))
     j = JOINT_NAMES.index("elbow")
-    assert np.abs(state[:, j, 2]).mean() > np.abs(h_state[:, j, 2]).mean() + 2.0
+    direction = np.sign(h_state[:, j, 1])  # the same reference motion in both runs
+
+    def along_motion(s: np.ndarray) -> float:  # the torque the drive spends along its motion
+        return float((s[:, j, 2] * direction).mean())
+
+    # the drive's own friction costs it torque along the motion (gravity, the larger part of the
+    # elbow's torque, is the same in both runs and averages out of this)
+    assert along_motion(state) > along_motion(h_state) + 2.0
 
 
 def test_torque_residual_is_near_zero_healthy_and_rises_by_the_added_friction(model):

@@ -1,0 +1,210 @@
+"""Arm descriptions: one UR e-Series arm as data, read from ``assets/<arm>/``.
+
+UR's own parameter files (``ur_description/``, copied verbatim from UR's ROS 2 description
+package) give the kinematics, the link inertials and the joint limits; ``arm.yaml`` adds what
+they lack (rated payload, reach, UR's DH table for the independent checks). Light on purpose
+(numpy and yaml only): the torch- and MuJoCo-free runtime reads an arm's ratings from here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.resources import asset_dir
+from robohealth_mj.schema import JOINT_NAMES
+
+DEFAULT_ARM = "ur5e"
+# UR's link names in the description files, in the schema's joint order (joint i moves link i).
+LINK_KEYS = ("shoulder", "upper_arm", "forearm", "wrist_1", "wrist_2", "wrist_3")
+LINK_BODIES = tuple(f"{k}_link" for k in LINK_KEYS)
+
+
+class _Loader(yaml.SafeLoader):
+    """UR's joint-limit files write angles as ``!degrees 360.0``."""
+
+
+_Loader.add_constructor("!degrees", lambda loader, node: math.radians(float(node.value)))
+
+
+@dataclass(frozen=True)
+class Link:
+    """One link's inertial as UR's description gives it, in the URDF link frame."""
+
+    origin_xyz: np.ndarray  # [3] the joint moving this link, in the parent link's frame
+    origin_rpy: np.ndarray  # [3] URDF roll, pitch, yaw of that joint frame
+    mass: float
+    com: np.ndarray  # [3] centre of mass in the link frame
+    inertia_rpy: np.ndarray  # [3] orientation of the inertia frame
+    inertia: np.ndarray  # [3, 3] inertia tensor about the com, in the inertia frame
+
+
+@dataclass(frozen=True)
+class ArmDescription:
+    """Everything the builder, the curriculum and the ratings need about one arm."""
+
+    name: str
+    links: tuple[Link, ...]  # in schema joint order
+    base_mass: float
+    base_radius: float
+    base_length: float
+    rated_torque: np.ndarray  # [6] N m (UR's max_effort)
+    speed_limit: np.ndarray  # [6] rad/s
+    position_limit: np.ndarray  # [6, 2] rad
+    payload_kg: float
+    reach_m: float
+    dh: dict[str, np.ndarray]  # d, a, alpha [6]; mass [6]; com [6, 3] (UR's DH table)
+    source: Path
+
+    def ratings(self) -> dict[str, Any]:
+        """The arm's identity and ratings, as manifests and checkpoints carry them."""
+        return {
+            "arm": self.name,
+            "rated_torque_nm": [round(float(v), 6) for v in self.rated_torque],
+            "speed_limit_rad_s": [round(float(v), 6) for v in self.speed_limit],
+            "payload_kg": self.payload_kg,
+            "reach_m": self.reach_m,
+        }
+
+
+def known_arms() -> tuple[str, ...]:
+    """The arms shipped in ``assets/`` (each a folder with an ``arm.yaml``)."""
+    return tuple(sorted(p.parent.name for p in asset_dir().glob("*/arm.yaml")))
+
+
+def _read(path: Path) -> dict:
+    try:
+        data = yaml.load(path.read_text(encoding="utf-8"), Loader=_Loader)
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror})") from None
+    except yaml.YAMLError as e:
+        raise InputError(f"{path}: not YAML ({str(e).splitlines()[0]})") from None
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: expected a mapping")
+    return data
+
+
+def _field(data: dict, path: Path, *keys: str) -> Any:
+    """``data[k0][k1]...``, or a one-line error naming the file and the missing field."""
+    node: Any = data
+    for depth, key in enumerate(keys):
+        if not isinstance(node, dict) or key not in node:
+            raise InputError(f"{path}: missing field {'.'.join(keys[: depth + 1])}")
+        node = node[key]
+    return node
+
+
+def _number(data: dict, path: Path, *keys: str) -> float:
+    value = _field(data, path, *keys)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: field {'.'.join(keys)} is not a number ({value!r})") from None
+    if not math.isfinite(number):
+        raise InputError(f"{path}: field {'.'.join(keys)} is not finite ({value!r})")
+    return number
+
+
+def _vector(data: dict, path: Path, *keys: str, n: int) -> np.ndarray:
+    value = _field(data, path, *keys)
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: field {'.'.join(keys)} is not numeric") from None
+    if arr.shape[:1] != (n,) or not np.all(np.isfinite(arr)):
+        raise InputError(f"{path}: field {'.'.join(keys)} needs {n} finite values")
+    return arr
+
+
+def _position_limit(lim: dict, path: Path, joint: tuple[str, str]) -> list[float]:
+    """``[min, max]``, or unlimited where UR says the joint has none (a UR3e's wrist 3)."""
+    if not _field(lim, path, *joint).get("has_position_limits", True):
+        return [-math.inf, math.inf]
+    return [_number(lim, path, *joint, "min_position"), _number(lim, path, *joint, "max_position")]
+
+
+def load_arm(name: str = DEFAULT_ARM) -> ArmDescription:
+    """The description of arm ``name`` (a folder of ``assets/``), validated field by field."""
+    folder = asset_dir() / str(name)
+    if not (folder / "arm.yaml").is_file():
+        raise InputError(f"unknown arm {name!r}; known: {', '.join(known_arms())}")
+    return _load(folder, str(name))
+
+
+@cache
+def _load(folder: Path, name: str) -> ArmDescription:
+    ours = _read(folder / "arm.yaml")
+    ur = folder / "ur_description"
+    kin_path, phys_path, lim_path = (
+        ur / "default_kinematics.yaml",
+        ur / "physical_parameters.yaml",
+        ur / "joint_limits.yaml",
+    )
+    kin, phys, lim = _read(kin_path), _read(phys_path), _read(lim_path)
+    links = []
+    for key in LINK_KEYS:
+        k = ("kinematics", key)
+        tensor = ("inertia_parameters", "tensor", key)
+        i = {
+            c: _number(phys, phys_path, *tensor, c)
+            for c in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+        }
+        cog = ("inertia_parameters", "center_of_mass", f"{key}_cog")
+        rot = ("inertia_parameters", "rotation", key)
+        links.append(
+            Link(
+                origin_xyz=np.array([_number(kin, kin_path, *k, c) for c in "xyz"]),
+                origin_rpy=np.array(
+                    [_number(kin, kin_path, *k, c) for c in ("roll", "pitch", "yaw")]
+                ),
+                mass=_number(phys, phys_path, "inertia_parameters", f"{key}_mass"),
+                com=np.array([_number(phys, phys_path, *cog, c) for c in "xyz"]),
+                inertia_rpy=np.array(
+                    [_number(phys, phys_path, *rot, c) for c in ("roll", "pitch", "yaw")]
+                ),
+                inertia=np.array(
+                    [
+                        [i["ixx"], i["ixy"], i["ixz"]],
+                        [i["ixy"], i["iyy"], i["iyz"]],
+                        [i["ixz"], i["iyz"], i["izz"]],
+                    ]
+                ),
+            )
+        )
+    limits = [("joint_limits", f"{j}_joint") for j in JOINT_NAMES]
+    base = ("inertia_parameters", "links", "base")
+    dh_path = folder / "arm.yaml"
+    desc = ArmDescription(
+        name=str(_field(ours, dh_path, "name")),
+        links=tuple(links),
+        base_mass=_number(phys, phys_path, "inertia_parameters", "base_mass"),
+        base_radius=_number(phys, phys_path, *base, "radius"),
+        base_length=_number(phys, phys_path, *base, "length"),
+        rated_torque=np.array([_number(lim, lim_path, *j, "max_effort") for j in limits]),
+        speed_limit=np.array([_number(lim, lim_path, *j, "max_velocity") for j in limits]),
+        position_limit=np.array([_position_limit(lim, lim_path, j) for j in limits]),
+        payload_kg=_number(ours, dh_path, "payload_kg"),
+        reach_m=_number(ours, dh_path, "reach_m"),
+        dh={
+            **{k: _vector(ours, dh_path, "dh", k, n=6) for k in ("d", "a", "alpha", "mass")},
+            "com": _vector(ours, dh_path, "dh", "com", n=6),
+        },
+        source=folder,
+    )
+    if desc.name != name:
+        raise InputError(f"{dh_path}: field name is {desc.name!r}, the folder says {name!r}")
+    if desc.dh["com"].shape != (6, 3):
+        raise InputError(f"{dh_path}: field dh.com needs 6 rows of 3 values")
+    for what, values in (("max_effort", desc.rated_torque), ("max_velocity", desc.speed_limit)):
+        if np.any(values <= 0):
+            raise InputError(f"{lim_path}: every joint's {what} must be positive")
+    if desc.payload_kg <= 0 or desc.reach_m <= 0:
+        raise InputError(f"{dh_path}: payload_kg and reach_m must be positive")
+    return desc
