@@ -16,6 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
+import mujoco
 import numpy as np
 
 with warnings.catch_warnings():
@@ -38,34 +39,24 @@ BASE_YAW = np.pi / 2
 
 def quat_rpy(rpy: np.ndarray) -> np.ndarray:
     """The quaternion (w x y z) of a URDF roll-pitch-yaw: ``Rz(yaw) Ry(pitch) Rx(roll)``."""
-
-    def about(axis: int, angle: float) -> np.ndarray:
-        q = np.zeros(4)
-        q[0], q[1 + axis] = np.cos(angle / 2), np.sin(angle / 2)
-        return q
-
-    r, p, y = (float(v) for v in rpy)
-    return _qmul(_qmul(about(2, y), about(1, p)), about(0, r))
+    out = np.array([1.0, 0.0, 0.0, 0.0])
+    for axis, angle in zip(np.eye(3)[::-1], np.asarray(rpy, float)[::-1], strict=True):
+        step = np.empty(4)
+        mujoco.mju_axisAngle2Quat(step, axis, float(angle))
+        mujoco.mju_mulQuat(out, out.copy(), step)
+    return out
 
 
 def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array([
-        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-    ])  # fmt: skip
+    out = np.empty(4)
+    mujoco.mju_mulQuat(out, np.asarray(a, float), np.asarray(b, float))
+    return out
 
 
 def _rotation(q: np.ndarray) -> np.ndarray:
-    w, x, y, z = q / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ])  # fmt: skip
+    out = np.empty(9)
+    mujoco.mju_quat2Mat(out, np.asarray(q, float))
+    return out.reshape(3, 3)
 
 
 @dataclass(frozen=True)
