@@ -1,6 +1,6 @@
 """``python -m robohealth_mj.bench``: throughput benchmarks (not tests).
 
-    python -m robohealth_mj.bench sim [--duration 60]
+    python -m robohealth_mj.bench sim [--duration 60] [--arms ur5e,ur3e,ur10e,ur16e] [arm=ur10e]
     python -m robohealth_mj.bench models [--windows 16 32] [--variants anomaly_residual ...]
     python -m robohealth_mj.bench train [--data 'outputs/corpus/quick/train_*'] [--window 32]
     python -m robohealth_mj.bench train --headline [OVERRIDE ...]
@@ -34,6 +34,12 @@ def main(argv: list[str] | None = None) -> None:
     sub = parser.add_subparsers(dest="what", required=True)
     sim = sub.add_parser("sim", help="raw mj_step rate vs recorder throughput")
     sim.add_argument("--duration", type=float, default=60.0, help="simulated seconds to record")
+    sim.add_argument(
+        "--arms",
+        default=None,
+        help="comma-separated arms (ur3e,ur5e,ur10e,ur16e) measured back to back in this run, "
+        "each recorder's throughput against the first's",
+    )
     sim.add_argument("overrides", nargs="*", help="Hydra overrides for conf/record.yaml")
     models = sub.add_parser("models", help="parameters and batch-1 CPU latency per variant")
     models.add_argument("--windows", type=int, nargs="+", default=[16, 32])
@@ -117,6 +123,18 @@ def main(argv: list[str] | None = None) -> None:
     else:
         from robohealth_mj.benchmarks.sim import bench_sim
 
+        if args.arms:
+            rates = {}
+            for arm in args.arms.split(","):
+                r = bench_sim(args.duration, [*args.overrides, f"arm={arm}"])
+                rates[arm] = r["recorder_sim_s_per_s"]
+                first = next(iter(rates.values()))
+                print(
+                    f"{arm:<6} raw {r['raw_steps_per_s']:>8.0f} steps/s  recorder "
+                    f"{r['recorder_sim_s_per_s']:>6.1f}x real time  "
+                    f"{r['recorder_sim_s_per_s'] / first:>6.1%} of {next(iter(rates))}'s"
+                )
+            return
         r = bench_sim(args.duration, args.overrides)
         print(
             f"raw mj_step rate      {r['raw_steps_per_s']:>10.0f} steps/s "

@@ -34,7 +34,8 @@ def main(argv: list[str] | None = None) -> None:
         record = commission(cfg.model, healthy, out, cfg.reference, cfg.export, placement=placement,
                             placement_fit=cfg.placement_fit,
                             placement_prune=cfg.get("placement_prune"),
-                            operating_point=cfg.operating_point)  # fmt: skip
+                            operating_point=cfg.operating_point,
+                            arm=cfg.get("arm"))  # fmt: skip
         atomic_write_json(out / "commissioning.json", record)
     print(f"{record['healthy_minutes']:g} healthy minutes -> {record['checkpoint']}")
     for row in record["settling"]:

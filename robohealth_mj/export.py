@@ -22,10 +22,11 @@ def main(cfg: DictConfig) -> None:
         raise SystemExit("usage: python -m robohealth_mj.export ckpt=PATH [out=model.onnx]")
     out = cfg.out or Path(cfg.ckpt).with_name("model.onnx")
     with one_line_errors("export"):
-        result = export_checkpoint(cfg.ckpt, out, cfg.data, cfg.parity_windows)
+        result = export_checkpoint(cfg.ckpt, out, cfg.data, cfg.parity_windows, cfg.get("arm"))
     incremental = result["metadata"].get("incremental_parity_error")
     print(
-        f"exported {result['metadata']['model_id']} -> {result['path']} "
+        f"exported {result['metadata']['model_id']} for the {result['metadata']['arm']} -> "
+        f"{result['path']} "
         f"(parity {result['parity_error']:.2g} on {result['windows']} held-out windows"
         + (f"; incremental form parity {incremental}" if incremental else "; windowed only")
         + ")"

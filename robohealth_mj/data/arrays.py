@@ -10,14 +10,15 @@ import glob
 import hashlib
 import io
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from robohealth_mj.common.atomic import atomic_write_bytes
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.data.read import is_bag, read_samples
+from robohealth_mj.data.read import is_bag, read_samples, recording_arm
+from robohealth_mj.data.relative import REFERENCE_ARM, to_relative
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, SCHEMA_VERSION
 
 CACHE_SUFFIX = ".cache.npz"
@@ -25,7 +26,9 @@ CACHE_SUFFIX = ".cache.npz"
 
 @dataclass
 class Recording:
-    """All samples of one or more files, in file order. ``run`` indexes ``run_ids``."""
+    """All samples of one or more files, in file order. ``run`` indexes ``run_ids`` and
+    ``arms`` (each run's arm; empty: the reference arm's). ``x`` holds relative channels
+    (:mod:`robohealth_mj.data.relative`): for the UR5e, the readings as recorded."""
 
     x: np.ndarray  # [T, N, F] float32
     run: np.ndarray  # [T] int32
@@ -37,6 +40,7 @@ class Recording:
     active: np.ndarray  # [T] bool
     payload_scale: np.ndarray  # [T] float32
     sources: list[str]
+    arms: list[str] = field(default_factory=list)  # [len(run_ids)] the arm of each run
 
     def __len__(self) -> int:
         return len(self.x)
@@ -106,9 +110,26 @@ def _load_one(path: Path) -> dict[str, np.ndarray]:
     return arrays
 
 
-def load_recordings(paths: list[Path | str]) -> Recording:
-    """Load (from cache when fresh) and concatenate recordings; run ids stay distinct."""
-    parts = [_load_one(Path(p)) for p in paths]
+def file_arm(path: Path | str, arm: str | None = None) -> str:
+    """The arm whose ratings a file's channels are read against: the one its manifest names;
+    else ``arm`` (what the user says a log or bag comes from); else the reference arm."""
+    named = recording_arm(path)
+    if named is not None and arm is not None and named != arm:
+        raise InputError(f"{path}: a recording of a {named}, not of a {arm} (arm={arm})")
+    return named or arm or REFERENCE_ARM
+
+
+def load_recordings(paths: list[Path | str], arm: str | None = None) -> Recording:
+    """Load (from cache when fresh) and concatenate recordings; run ids stay distinct; each
+    file's torques and speeds relative to its arm's ratings (``arm``: the arm of files that
+    name none; default the reference arm)."""
+    parts, arms = [], []
+    for p in paths:
+        part, name = _load_one(Path(p)), file_arm(p, arm)
+        if name != REFERENCE_ARM:
+            part = {**part, "x": to_relative(part["x"], name)}
+        parts.append(part)
+        arms += [name] * len(part["run_ids"])
     run_ids: list[str] = []
     runs = []
     for part in parts:
@@ -131,7 +152,11 @@ def load_recordings(paths: list[Path | str]) -> Recording:
         )
     }
     return Recording(
-        run=np.concatenate(runs), run_ids=run_ids, sources=[str(p) for p in paths], **cat
+        run=np.concatenate(runs),
+        run_ids=run_ids,
+        sources=[str(p) for p in paths],
+        arms=arms,
+        **cat,
     )
 
 

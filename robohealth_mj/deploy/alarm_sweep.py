@@ -20,6 +20,7 @@ import numpy as np
 from robohealth_mj import schema
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import load_recordings
+from robohealth_mj.data.relative import to_raw
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
@@ -47,6 +48,12 @@ def replay_decisions(model: str | Path, recording: str | Path) -> Decisions:
     fleet = FleetRuntime(model)
     if fleet.engine is None:
         raise InputError(fleet.problem)
+    if rec.arms and rec.arms[0] != fleet.arm:
+        raise InputError(
+            f"{recording}: a recording of a {rec.arms[0]}; {model} reads a {fleet.arm} (export "
+            f"one for the {rec.arms[0]}: python -m robohealth_mj.export data=<that recording>)"
+        )
+    raw = to_raw(rec.x, fleet.arm)  # the runtime takes the arm's readings as they arrive
     slot = fleet.register([str(recording)])
     n = len(rec)
     decided = np.zeros(n, bool)
@@ -54,7 +61,7 @@ def replay_decisions(model: str | Path, recording: str | Path) -> Decisions:
     scores = np.zeros((n, len(fleet.joints)), np.float32)
     for k in range(n):
         r = fleet.step(slot, rec.sample_index[k : k + 1], rec.sample_index[k : k + 1] * 0.05 + 0.05,
-                       rec.x[k : k + 1])  # fmt: skip
+                       raw[k : k + 1])  # fmt: skip
         decided[k] = r.status[0] == DECIDED
         probs[k], scores[k] = r.probs[0], r.joint_scores[0]
     truth = [

@@ -21,7 +21,7 @@ from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data import baseline
-from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
+from robohealth_mj.data.arrays import Recording, expand_paths, file_arm, load_recordings
 from robohealth_mj.data.graphs import GraphSpec, harness_graph
 from robohealth_mj.deploy.export import export_checkpoint, file_fingerprint
 from robohealth_mj.deploy.operating_point import Reading, check_recipe, match_operating_point
@@ -40,10 +40,10 @@ MINUTES = (0.5, 1.0, 2.0, 3.0, 5.0, 7.5, 10.0, 15.0, 20.0)
 SETTLED = 0.1  # a baseline has settled when it moves the residuals within 10 % of the final fit
 
 
-def _healthy(ckpt: dict, paths: list[str] | str, what: str) -> Recording:
+def _healthy(ckpt: dict, paths: list[str] | str, what: str, arm: str | None = None) -> Recording:
     files = expand_paths(paths)
     check_recordings(ckpt, files)
-    rec = load_recordings(files)
+    rec = load_recordings(files, arm)
     if what == "healthy" and rec.active.any():
         raise InputError(
             f"{files[0]}: {int(rec.active.sum())} of the {what} ticks carry an active fault; "
@@ -103,14 +103,20 @@ def commission(
     placement_fit: str = "motion",
     placement_prune: float | None = None,
     operating_point: str = "per_class",
+    arm: str | None = None,
 ) -> dict[str, Any]:
     """Write ``out_dir/best.ckpt`` (and ``model.onnx`` for a network) commissioned on
     ``healthy``; the commissioning record (also in the checkpoint). A harness model with a
     coupling head also has its ``C`` refitted to the arm's ``placement``
-    (:mod:`robohealth_mj.deploy.recouple`)."""
+    (:mod:`robohealth_mj.deploy.recouple`). ``arm``: the arm ``healthy`` comes from where it
+    names none (a controller log, a bag)."""
     check_recipe(operating_point)  # before minutes of work, not after
     ckpt = load_checkpoint(ckpt_path)
-    arm = _healthy(ckpt, healthy, "healthy")
+    healthy_files = expand_paths(healthy)
+    arm_name = sorted({file_arm(f, arm) for f in healthy_files})
+    if len(arm_name) > 1:
+        raise InputError(f"healthy: commission on one arm's running; got {', '.join(arm_name)}")
+    arm = _healthy(ckpt, [str(f) for f in healthy_files], "healthy", arm_name[0])
     reference = reference or ckpt["config"].get("data", {}).get("train")
     if not reference:
         raise InputError(f"{ckpt_path}: no training data named in it: pass reference=DATA")
@@ -127,7 +133,8 @@ def commission(
         None,
     )  # fmt: skip
     record = {
-        "healthy": [str(p) for p in expand_paths(healthy)],
+        "arm": arm_name[0],
+        "healthy": [str(p) for p in healthy_files],
         "healthy_fingerprint": arm.fingerprint(),
         "healthy_minutes": round(len(arm) / tick_hz / 60.0, 2),
         "reference_fingerprint": ref.fingerprint(),
@@ -191,6 +198,8 @@ def commission(
         extra={
             "gamma": ckpt.get("gamma"),
             "split_runs": ckpt.get("split_runs"),
+            "arms": ckpt.get("arms"),
+            "transfer": ckpt.get("transfer"),
             "commissioning": record,
             "class_offset": offset.tolist(),
         },
@@ -198,7 +207,9 @@ def commission(
     record["checkpoint"] = str(out_dir / CHECKPOINT)
     network = not callable(getattr(model, "fit", None))
     if export and network:
-        result = export_checkpoint(out_dir / CHECKPOINT, out_dir / "model.onnx", data=healthy)
+        result = export_checkpoint(
+            out_dir / CHECKPOINT, out_dir / "model.onnx", data=healthy, arm=arm_name[0]
+        )
         record["onnx"] = result["path"]
         record["onnx_fingerprint"] = file_fingerprint(result["path"])
     return record

@@ -1,9 +1,10 @@
 """Exporting a checkpoint to a self-contained ONNX model.
 
-The model takes *raw* schema windows ``x: float32[B, W, 12, F]``: the graph transform (the
-harness mixing, when the model was trained under it) and the normalisation are inside the graph,
-so a deployment feeds sensor readings as they arrive. Metadata carries everything the runtime
-checks: node order, feature names, window, label table, schema version, fingerprints.
+The model takes *raw* schema windows ``x: float32[B, W, 12, F]`` of one arm: that arm's channel
+scale (:mod:`robohealth_mj.data.relative`), the graph transform (the harness mixing, when the
+model was trained under it) and the normalisation are inside the graph, so a deployment feeds
+sensor readings as they arrive. Metadata carries everything the runtime checks: node order,
+feature names, window, label table, schema version, fingerprints, the arm it reads.
 """
 
 from __future__ import annotations
@@ -22,8 +23,10 @@ from torch import nn
 
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_bytes
-from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.data.arrays import Recording, expand_paths, file_arm, load_recordings
 from robohealth_mj.data.baseline import shift
+from robohealth_mj.data.relative import channel_scale, to_raw
 from robohealth_mj.data.windows import make_windows
 from robohealth_mj.learn.checkpoint import (
     check_recordings,
@@ -39,9 +42,9 @@ PARITY_TOLERANCE = 1e-4
 
 
 class RawInput(nn.Module):
-    """Schema window -> the commissioned arm's residuals onto the training arms' baseline -> the
-    sensing profile's channels and nodes -> the model's graph (harness mixing) -> training-split
-    z-scores."""
+    """Schema window of the arm's raw readings -> relative channels -> the commissioned arm's
+    residuals onto the training arms' baseline -> the sensing profile's channels and nodes -> the
+    model's graph (harness mixing) -> training-split z-scores."""
 
     def __init__(
         self,
@@ -51,9 +54,13 @@ class RawInput(nn.Module):
         channel_mask: np.ndarray | None = None,
         schema_nodes: int = schema.N_NODES,
         baseline_shift: np.ndarray | None = None,
+        channel_scale: np.ndarray | None = None,
     ) -> None:
         super().__init__()
         self.schema_nodes = schema_nodes
+        self.scaled = channel_scale is not None and not np.all(channel_scale == 1.0)
+        if self.scaled:
+            self.register_buffer("channel_scale", torch.tensor(np.array(channel_scale)).float())
         self.shifted = baseline_shift is not None
         if self.shifted:
             self.register_buffer("baseline_shift", torch.as_tensor(baseline_shift).float())
@@ -67,6 +74,8 @@ class RawInput(nn.Module):
             self.register_buffer("coupling", torch.as_tensor(coupling, dtype=torch.float32))
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
+        if self.scaled:
+            x = x * self.channel_scale
         if self.shifted:
             x = shift(x, self.baseline_shift)
         if self.masked:
@@ -92,32 +101,39 @@ def file_fingerprint(path: Path | str) -> str:
     return digest.hexdigest()[:16]
 
 
-def heldout_recording(ckpt: dict[str, Any], data: str | list[str] | None) -> Recording:
-    """The held-out data the parity checks run on (``data`` or the checkpoint's own)."""
+def heldout_recording(
+    ckpt: dict[str, Any], data: str | list[str] | None, arm: str | None = None
+) -> tuple[Recording, str]:
+    """The held-out data the parity checks run on (``data`` or the checkpoint's own) and the
+    arm it comes from, which the exported model reads (``arm``: for data that names none)."""
     data = data or ckpt["config"].get("data", {}).get("evaluate", {}).get("heldout")
     if not data:
         raise ValueError("no held-out data for the parity check: pass data=PATH")
     files = expand_paths(data)
     check_recordings(ckpt, files)
-    return load_recordings(files)
+    arms = sorted({file_arm(f, arm) for f in files})
+    if len(arms) > 1:
+        raise InputError(f"data: an exported model reads one arm; the data has {', '.join(arms)}")
+    return load_recordings(files, arm), arms[0]
 
 
-def heldout_windows(rec: Recording, window: int, count: int) -> torch.Tensor:
-    """Up to ``count`` raw windows ``[K, W, 12, F]`` spread over a held-out recording."""
+def heldout_windows(rec: Recording, window: int, count: int, arm: str) -> torch.Tensor:
+    """Up to ``count`` raw windows ``[K, W, 12, F]`` (arm ``arm``'s readings) spread over a
+    held-out recording."""
     windows = make_windows(rec, window)
     pick = np.linspace(0, len(windows) - 1, min(count, len(windows))).astype(int)
     idx = windows.start[pick][:, None] + np.arange(windows.window)
-    return torch.from_numpy(rec.x[idx])
+    return torch.from_numpy(to_raw(rec.x[idx], arm))
 
 
-def heldout_run(rec: Recording, count: int) -> torch.Tensor:
+def heldout_run(rec: Recording, count: int, arm: str) -> torch.Tensor:
     """The first ``count`` consecutive raw snapshots ``[count, 12, F]`` of one held-out run."""
     step = np.diff(rec.sample_index, prepend=rec.sample_index[0] - 1)
     same = (rec.run == rec.run[0]) & (step == 1)
     length = int(np.argmin(same)) if not same.all() else len(rec)
     if length < count:
         raise ValueError(f"held-out data has no run of {count} consecutive samples")
-    return torch.from_numpy(rec.x[:count])
+    return torch.from_numpy(to_raw(rec.x[:count], arm))
 
 
 def incremental_graphs(
@@ -199,8 +215,10 @@ def export_checkpoint(
     out: Path | str,
     data: str | list[str] | None = None,
     parity_windows: int = 256,
+    arm: str | None = None,
 ) -> dict[str, Any]:
-    """Write ``out`` (ONNX) and verify it against PyTorch on real held-out windows."""
+    """Write ``out`` (ONNX) for the arm ``data`` comes from (``arm`` where it names none) and
+    verify it against PyTorch on real held-out windows of it."""
     ckpt = load_checkpoint(ckpt_path)
     model = model_from_checkpoint(ckpt)
     if callable(getattr(model, "fit", None)):
@@ -209,6 +227,7 @@ def export_checkpoint(
             "export here; export a network variant"
         )
     graph = graph_from_checkpoint(ckpt)
+    rec, target = heldout_recording(ckpt, data, arm)
     pre = RawInput(
         ckpt["norm_mean"],
         ckpt["norm_std"],
@@ -216,10 +235,10 @@ def export_checkpoint(
         graph.channel_mask,
         graph.schema_nodes,
         graph.baseline_shift,
+        channel_scale(target),
     ).eval()
     window = int(ckpt["window"])
-    rec = heldout_recording(ckpt, data)
-    windows = heldout_windows(rec, window, parity_windows)
+    windows = heldout_windows(rec, window, parity_windows, target)
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
@@ -234,7 +253,7 @@ def export_checkpoint(
             f"> {PARITY_TOLERANCE} on {len(windows)} held-out windows"
         )
     incremental = (
-        incremental_graphs(model, pre, heldout_run(rec, 2 * window + 64), window)
+        incremental_graphs(model, pre, heldout_run(rec, 2 * window + 64, target), window)
         if supports_incremental(model)
         else {}
     )
@@ -255,6 +274,8 @@ def export_checkpoint(
         sensing=graph.sensing,
         label_set=json.dumps(list(graph.classes)),
         arms=json.dumps(list(ckpt.get("arms") or [])),
+        arm=target,
+        transfer=json.dumps(bool(ckpt.get("transfer"))),
         **commissioning_metadata(ckpt),
         **incremental,
     )

@@ -176,9 +176,11 @@ def training_arms(files: list) -> list[str]:
 def check_recordings(ckpt: dict[str, Any], files: list) -> None:
     """Refuse, in one line, a recording of another schema, one lacking channels the model reads
     (its sensing profile's: a full model on a controller log, say), or one of an arm the model was
-    not trained on (its torques and speeds are on another scale)."""
+    not trained on, unless it was trained for transfer (``transfer=true``, several arms): then
+    any arm whose description ships reads, its channels relative to its own ratings."""
     from robohealth_mj.data.read import recording_arm, recording_sensing
     from robohealth_mj.data.sensing import refuse_missing_channels
+    from robohealth_mj.sim.arms import load_arm
 
     sensing = graph_from_checkpoint(ckpt).sensing
     arms = list(ckpt.get("arms") or [])  # empty: trained on recordings that name no arm
@@ -186,11 +188,16 @@ def check_recordings(ckpt: dict[str, Any], files: list) -> None:
         check_schema(ckpt, str(f))
         refuse_missing_channels(sensing, recording_sensing(f), str(f))
         arm = recording_arm(f)
-        if arms and arm is not None and arm not in arms:
-            raise InputError(
-                f"{f}: a recording of a {arm}; the model was trained on {', '.join(arms)} and "
-                f"reads no other arm (train one on {arm} recordings)"
-            )
+        if not arms or arm is None or arm in arms:
+            continue
+        if ckpt.get("transfer"):
+            load_arm(arm)  # its description must be readable: the ratings scale its channels
+            continue
+        raise InputError(
+            f"{f}: a recording of a {arm}; the model was trained on {', '.join(arms)} and "
+            f"reads no other arm (train one on {arm} recordings, or one with transfer=true on "
+            "several arms)"
+        )
 
 
 def check_schema(ckpt: dict[str, Any], source: str) -> None:

@@ -22,6 +22,7 @@ from tqdm import tqdm
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.config import placement_name
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.version import code_version
 from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.data.graphs import GraphSpec, coupling_correlation
@@ -116,7 +117,9 @@ def prepare(cfg: DictConfig) -> Prepared:
         torch.set_num_threads(int(cfg.trainer.threads))
     device = pick_device(cfg.trainer.device)
     graph: GraphSpec = instantiate(cfg.graph).with_sensing(instantiate(cfg.sensing))
-    rec = graph.relabel(load_recordings(expand_paths(cfg.data.train)))
+    files = expand_paths(cfg.data.train)
+    check_transfer(cfg, files)
+    rec = graph.relabel(load_recordings(files))
     x = graph.transform(rec.x)
     windows = make_windows(rec, int(cfg.window), cfg.stride)
     splits = run_aware_split(rec, windows, int(cfg.seed))
@@ -158,8 +161,20 @@ def _save(p: Prepared, out_dir: Path, best_epoch: int, gamma: float | None) -> N
             "gamma": gamma,
             "split_runs": split_runs(p),
             "arms": training_arms(expand_paths(cfg.data.train)),
+            "transfer": bool(cfg.get("transfer", False)),
         },
     )
+
+
+def check_transfer(cfg: DictConfig, files: list) -> None:
+    """A model trained for transfer must have seen more than one arm (one arm's ratings say
+    nothing of how a fault reads on another)."""
+    if cfg.get("transfer", False) and len(training_arms(files)) < 2:
+        arms = training_arms(files) or ["no named arm"]
+        raise InputError(
+            f"transfer=true needs training recordings of two arms or more; data.train has "
+            f"{', '.join(arms)}"
+        )
 
 
 def split_runs(p: Prepared) -> dict[str, list[str]]:

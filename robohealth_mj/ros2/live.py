@@ -181,7 +181,7 @@ def monitor_arms(cfg: DictConfig, runtime: Any, policy: Any, evidence: Any) -> d
 
     def evaluate(arm: str, sample: GraphSample, d: Any) -> None:
         if arm not in evaluators:
-            evaluators[arm] = OnlineEvaluator(settle_ticks=settle)
+            evaluators[arm] = OnlineEvaluator(settle_ticks=settle, arm=runtime.arm)
         evaluators[arm].update(sample.fault, d, *joint_activity(sample.x))
 
     counts = run_monitor(cfg.ros2, runtime, cfg.duration_s or None,

@@ -28,6 +28,7 @@ from robohealth_mj import schema
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
+from robohealth_mj.sim.arms import DEFAULT_ARM
 
 log = logging.getLogger(__name__)
 
@@ -120,6 +121,7 @@ class FleetRuntime:
         self._pool = ThreadPoolExecutor(self.shards) if self.shards > 1 else None
         self.window, self.model_id, self.problem = 16, "none", None
         self.joint_scores = "softmax"
+        self.arm = DEFAULT_ARM  # the arm whose raw readings the model takes
         self.classes, self.joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
         self.engine: IncrementalEngine | WindowedEngine | None = None
         self.mode = "none"
@@ -174,6 +176,7 @@ class FleetRuntime:
             return ort.InferenceSession(model, options, providers=providers)
 
         self.window = int(meta["window"])
+        self.arm = meta.get("arm", DEFAULT_ARM)  # models exported before arms were data: UR5e
         self.classes, self.joints = meta["classes"], meta["joints"]
         # models exported before the key existed were all trained with the softmax joint loss
         self.joint_scores = meta.get("joint_scores", "softmax")
@@ -404,6 +407,7 @@ class FleetRuntime:
     def describe(self) -> dict:
         return {
             "model_id": self.model_id,
+            "arm": self.arm,
             "window": self.window,
             "mode": self.mode,
             "threads": self.threads,

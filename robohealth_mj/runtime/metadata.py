@@ -38,7 +38,8 @@ def read_metadata(path: Path | str) -> dict[str, Any]:
             f"[batch, {', '.join(map(str, expected))}] (x)"
         )
     decoded: dict[str, Any] = dict(raw)
-    for key in ("node_names", "feature_names", "edges", "classes", "joints", "outputs"):
+    for key in ("node_names", "feature_names", "edges", "classes", "joints", "outputs", "arms",
+                "transfer"):  # fmt: skip
         if key in raw:
             decoded[key] = json.loads(raw[key])
     if "window" in raw:

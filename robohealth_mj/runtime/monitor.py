@@ -17,7 +17,7 @@ from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.bags.writer import BagWriter
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.data.read import recording_sensing
+from robohealth_mj.data.read import recording_arm, recording_sensing
 from robohealth_mj.data.sensing import refuse_missing_channels
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
@@ -45,6 +45,16 @@ def refuse_lacking_data(model: str, data_sensing: str, source: str) -> None:
     refuse_missing_channels(read_metadata(model).get("sensing", "full"), data_sensing, source)
 
 
+def refuse_other_arm(model_arm: str, data_arm: str | None, source: str) -> None:
+    """One line when a recording names another arm than the one the exported model reads (its
+    readings would be read against the wrong ratings)."""
+    if data_arm is not None and data_arm != model_arm:
+        raise InputError(
+            f"{source}: a recording of a {data_arm}; the model reads a {model_arm} (export one "
+            f"for the {data_arm}: python -m robohealth_mj.export data=<a {data_arm} recording>)"
+        )
+
+
 def monitor_stream(
     cfg: DictConfig, runtime: ModelRuntime, policy: AlarmPolicy, evidence: EvidencePolicy
 ) -> dict | None:
@@ -61,12 +71,13 @@ def monitor_stream(
             )
         if cfg.model:
             refuse_lacking_data(cfg.model, recording_sensing(cfg.file), cfg.file)
+            refuse_other_arm(runtime.arm, recording_arm(cfg.file), cfg.file)
         stream = replay_stream(cfg.file)
     else:
         raise InputError(f"source must be sim, replay or ros2, got {cfg.source!r}")
     freeze_startup_heap()
     settle = runtime.window + policy.clear_after + evidence.clearing_ticks
-    evaluator = OnlineEvaluator(settle_ticks=settle) if cfg.evaluate else None
+    evaluator = OnlineEvaluator(settle_ticks=settle, arm=runtime.arm) if cfg.evaluate else None
     last, started, t0 = None, time.perf_counter(), None
     with ExitStack() as stack:
         bag = stack.enter_context(BagWriter(cfg.bag_out)) if cfg.bag_out else None

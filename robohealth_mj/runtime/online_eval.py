@@ -37,6 +37,7 @@ import numpy as np
 from robohealth_mj import schema
 from robohealth_mj.runtime.runtime import HealthDiagnosis
 from robohealth_mj.schema import FaultLabel
+from robohealth_mj.sim.arms import DEFAULT_ARM
 from robohealth_mj.sim.ratings import rated_torque_nm
 
 
@@ -90,6 +91,7 @@ def physically_hidden(ep: _Episode, rated_torque: np.ndarray) -> bool | None:
 @dataclass
 class OnlineEvaluator:
     tick_s: float = 0.05
+    arm: str = DEFAULT_ARM  # whose rated torques the fed torques are read against
     settle_ticks: int = 0
     decided: int = 0
     correct: int = 0
@@ -170,7 +172,7 @@ class OnlineEvaluator:
         by_both: dict[str, list[_Episode]] = defaultdict(list)
         by_joint: dict[str, list[_Episode]] = defaultdict(list)
         by_visibility: dict[str, list[_Episode]] = defaultdict(list)
-        rated = rated_torque_nm()
+        rated = rated_torque_nm(self.arm)
         for ep in self.episodes:
             by_class[ep.label.fault_class].append(ep)
             by_severity[f"{ep.label.severity:g}"].append(ep)

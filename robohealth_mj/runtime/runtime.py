@@ -132,6 +132,11 @@ class ModelRuntime:
         return self.fleet.model_id
 
     @property
+    def arm(self) -> str:
+        """The arm whose raw readings the model takes."""
+        return self.fleet.arm
+
+    @property
     def problem(self) -> str | None:
         return self.fleet.problem
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -383,6 +384,7 @@ def bad_files(deployed, tmp_path_factory) -> dict[str, Path]:
         "shape_onnx": root / "shape.onnx",
         "empty_recording": root / "empty" / "graphs.jsonl",
         "no_recording": root / "nothing",
+        "other_arm": root / "ur3e" / "graphs.jsonl",
     }
     files["empty_ckpt"].write_bytes(b"")
     files["truncated_ckpt"].write_bytes(good[: len(good) // 2])
@@ -408,6 +410,12 @@ def bad_files(deployed, tmp_path_factory) -> dict[str, Path]:
     files["empty_recording"].parent.mkdir()
     files["empty_recording"].write_text("")
     files["no_recording"].mkdir()
+    # the held-out session as its manifest would say were it a UR3e's
+    files["other_arm"].parent.mkdir()
+    shutil.copy(deployed["heldout"], files["other_arm"])
+    manifest = json.loads((deployed["heldout"].parent / "manifest.json").read_text())
+    manifest["arm_ratings"]["arm"] = "ur3e"
+    (files["other_arm"].parent / "manifest.json").write_text(json.dumps(manifest))
     return files
 
 
@@ -426,11 +434,16 @@ def bad_files(deployed, tmp_path_factory) -> dict[str, Path]:
         ("no_recording", "evaluate ckpt={ckpt} data={f}", ["nothing", "no recording"]),
         ("no_recording", "dataset summarize {f}", ["nothing", "no recording"]),
         ("empty_recording", "bag write {f}", ["graphs.jsonl", "no samples"]),
+        ("other_arm", "monitor model={onnx} source=replay file={f}", ["ur3e", "reads a ur5e"]),
+        ("other_arm", "evaluate ckpt={ckpt} data={f}", ["ur3e", "trained on ur5e"]),
     ],
 )  # fmt: skip
 def test_every_bad_file_gets_one_line_and_exit_status_2(deployed, bad_files, key, command, needles):
     args = command.format(
-        f=bad_files[key], heldout=deployed["heldout"], ckpt=deployed["structural_ckpt"]
+        f=bad_files[key],
+        heldout=deployed["heldout"],
+        ckpt=deployed["structural_ckpt"],
+        onnx=deployed["structural_onnx"],
     ).split()
     _one_line_error(_python(f"robohealth_mj.{args[0]}", *args[1:]), *needles)
 

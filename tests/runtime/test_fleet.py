@@ -301,7 +301,7 @@ def test_sharded_steps_decide_as_one_shard_does(deployed):
                  np.full(130, 0.65), rec.x[12:142])  # fmt: skip
     assert (r.status == DECIDED).all()
     assert two.describe() == {
-        "model_id": one.model_id, "window": 8, "mode": "incremental", "threads": 1,
+        "model_id": one.model_id, "arm": "ur5e", "window": 8, "mode": "incremental", "threads": 1,
         "joint_scores": "softmax", "problem": None,
     }  # fmt: skip
     assert one.model_id.startswith("stgnn_fixed-structural-w8-")

@@ -1,0 +1,128 @@
+"""The cross-arm table from the campaign's evaluations (``experiments/arms/campaign.py``).
+
+    python experiments/arms/summarise.py [--sensing full] > results/arms/results.md
+
+One row per held-out arm and variant: the arm's own model; the leave-one-arm-out model (trained
+with ``transfer=true`` on the three other arms) before and after commissioning on ten minutes
+of the arm's healthy running; the commissioned network's false alarms over the arm's healthy
+hour (the monitor's replay with its default alarm policy). Mean ± std over the seeds found.
+Also writes ``results/arms/results_<sensing>.csv``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+OUT = ROOT / "outputs" / "campaign_arms"
+RESULTS = ROOT / "results" / "arms"
+ARMS = ("ur3e", "ur5e", "ur10e", "ur16e")
+TICK_S = 0.05
+
+
+def _metrics(path: Path) -> dict | None:
+    return json.loads(path.read_text())["metrics"] if path.is_file() else None
+
+
+def collect(sensing: str, out: Path = OUT) -> dict[tuple[str, str], dict[str, list[float]]]:
+    """``(arm, variant) -> {column: [one value per seed]}``."""
+    table: dict[tuple[str, str], dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
+    for stage in ("own", "loao"):
+        for ev in sorted((out / sensing / stage).glob("*/**/seed*/eval_heldout.json")):
+            run = ev.parent
+            arm = run.relative_to(out / sensing / stage).parts[0]
+            variant = run.parts[-3]
+            row = table[(arm, variant)]
+            m = _metrics(ev)
+            row[f"{stage}_acc"].append(m["accuracy"])
+            row[f"{stage}_loc"].append(m["localisation_accuracy"])
+            after = _metrics(run / "commissioned" / "eval_heldout.json")
+            if stage == "loao" and after is not None:
+                row["after_acc"].append(after["accuracy"])
+                row["after_loc"].append(after["localisation_accuracy"])
+            alarms = [
+                json.loads(p.read_text()) for p in sorted(run.glob("commissioned/alarms_*.json"))
+            ]
+            if stage == "loao" and alarms:
+                hours = sum(a["settled_healthy_ticks"] for a in alarms) * TICK_S / 3600
+                row["false_alarms_per_hour"].append(sum(a["false_alarms"] for a in alarms) / hours)
+                row["healthy_hours"].append(hours)
+    return table
+
+
+def _cell(values: list[float], digits: int = 3) -> str:
+    if not values:
+        return "–"
+    if len(values) == 1:
+        return f"{values[0]:.{digits}f}"
+    return f"{np.mean(values):.{digits}f} ± {np.std(values):.{digits}f}"
+
+
+COLUMNS = ("own_acc", "own_loc", "loao_acc", "loao_loc", "after_acc", "after_loc",
+           "false_alarms_per_hour", "healthy_hours")  # fmt: skip
+
+
+def markdown(table: dict, sensing: str) -> str:
+    lines = [
+        f"### Cross-arm, sensing = {sensing} (held-out session of each arm, W = 32)",
+        "",
+        "| arm | variant | seeds | own acc. | own loc. | unseen acc. | unseen loc. | "
+        "commissioned acc. | commissioned loc. | Δ acc. vs own | Δ loc. vs own | "
+        "false alarms / healthy h |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for arm in ARMS:
+        for variant in sorted({v for a, v in table if a == arm}):
+            r = table[(arm, variant)]
+            seeds = max(len(r["own_acc"]), len(r["loao_acc"]))
+            gap = [
+                _cell([np.mean(r[f"after_{k}"]) - np.mean(r[f"own_{k}"])])
+                if r[f"after_{k}"] and r[f"own_{k}"]
+                else "–"
+                for k in ("acc", "loc")
+            ]
+            hours = f" ({np.mean(r['healthy_hours']):.2f} h)" if r["healthy_hours"] else ""
+            lines.append(
+                f"| {arm} | {variant} | {seeds} | {_cell(r['own_acc'])} | {_cell(r['own_loc'])} | "
+                f"{_cell(r['loao_acc'])} | {_cell(r['loao_loc'])} | {_cell(r['after_acc'])} | "
+                f"{_cell(r['after_loc'])} | {gap[0]} | {gap[1]} | "
+                f"{_cell(r['false_alarms_per_hour'], 2)}{hours} |"
+            )
+    return "\n".join(lines) + "\n"
+
+
+def write_csv(table: dict, path: Path) -> None:
+    buffer = io.StringIO()
+    w = csv.writer(buffer)
+    w.writerow(["arm", "variant", *[f"{c}_{s}" for c in COLUMNS for s in ("mean", "std", "n")]])
+    for (arm, variant), r in sorted(table.items()):
+        cells = []
+        for c in COLUMNS:
+            v = r[c]
+            cells += [f"{np.mean(v):.6g}", f"{np.std(v):.6g}", len(v)] if v else ["", "", 0]
+        w.writerow([arm, variant, *cells])
+    path.write_text(buffer.getvalue())
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sensing", default="full")
+    parser.add_argument("--out", type=Path, default=OUT, help="campaign root")
+    args = parser.parse_args()
+    table = collect(args.sensing, args.out)
+    if not table:
+        raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    write_csv(table, RESULTS / f"results_{args.sensing}.csv")
+    print(markdown(table, args.sensing))
+
+
+if __name__ == "__main__":
+    main()
