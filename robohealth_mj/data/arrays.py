@@ -119,6 +119,15 @@ def file_arm(path: Path | str, arm: str | None = None) -> str:
     return named or arm or REFERENCE_ARM
 
 
+def single_arm(paths: list[Path | str], arm: str | None = None, what: str = "data") -> str:
+    """The one arm ``paths`` all come from (see :func:`file_arm`); a one-line error when they
+    mix arms (what one exported model or one commissioning reads is one arm's)."""
+    arms = sorted({file_arm(p, arm) for p in paths})
+    if len(arms) > 1:
+        raise InputError(f"{what}: recordings of one arm expected; got {', '.join(arms)}")
+    return arms[0]
+
+
 def load_recordings(paths: list[Path | str], arm: str | None = None) -> Recording:
     """Load (from cache when fresh) and concatenate recordings; run ids stay distinct; each
     file's torques and speeds relative to its arm's ratings (``arm``: the arm of files that

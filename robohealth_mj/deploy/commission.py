@@ -21,7 +21,7 @@ from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data import baseline
-from robohealth_mj.data.arrays import Recording, expand_paths, file_arm, load_recordings
+from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings, single_arm
 from robohealth_mj.data.graphs import GraphSpec, harness_graph
 from robohealth_mj.deploy.export import export_checkpoint, file_fingerprint
 from robohealth_mj.deploy.operating_point import Reading, check_recipe, match_operating_point
@@ -113,10 +113,8 @@ def commission(
     check_recipe(operating_point)  # before minutes of work, not after
     ckpt = load_checkpoint(ckpt_path)
     healthy_files = expand_paths(healthy)
-    arm_name = sorted({file_arm(f, arm) for f in healthy_files})
-    if len(arm_name) > 1:
-        raise InputError(f"healthy: commission on one arm's running; got {', '.join(arm_name)}")
-    arm = _healthy(ckpt, [str(f) for f in healthy_files], "healthy", arm_name[0])
+    arm_name = single_arm(healthy_files, arm, "healthy")
+    arm = _healthy(ckpt, [str(f) for f in healthy_files], "healthy", arm_name)
     reference = reference or ckpt["config"].get("data", {}).get("train")
     if not reference:
         raise InputError(f"{ckpt_path}: no training data named in it: pass reference=DATA")
@@ -133,7 +131,7 @@ def commission(
         None,
     )  # fmt: skip
     record = {
-        "arm": arm_name[0],
+        "arm": arm_name,
         "healthy": [str(p) for p in healthy_files],
         "healthy_fingerprint": arm.fingerprint(),
         "healthy_minutes": round(len(arm) / tick_hz / 60.0, 2),
@@ -208,7 +206,7 @@ def commission(
     network = not callable(getattr(model, "fit", None))
     if export and network:
         result = export_checkpoint(
-            out_dir / CHECKPOINT, out_dir / "model.onnx", data=healthy, arm=arm_name[0]
+            out_dir / CHECKPOINT, out_dir / "model.onnx", data=healthy, arm=arm_name
         )
         record["onnx"] = result["path"]
         record["onnx_fingerprint"] = file_fingerprint(result["path"])

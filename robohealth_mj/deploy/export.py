@@ -23,8 +23,7 @@ from torch import nn
 
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_bytes
-from robohealth_mj.common.errors import InputError
-from robohealth_mj.data.arrays import Recording, expand_paths, file_arm, load_recordings
+from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings, single_arm
 from robohealth_mj.data.baseline import shift
 from robohealth_mj.data.relative import channel_scale, to_raw
 from robohealth_mj.data.windows import make_windows
@@ -111,10 +110,7 @@ def heldout_recording(
         raise ValueError("no held-out data for the parity check: pass data=PATH")
     files = expand_paths(data)
     check_recordings(ckpt, files)
-    arms = sorted({file_arm(f, arm) for f in files})
-    if len(arms) > 1:
-        raise InputError(f"data: an exported model reads one arm; the data has {', '.join(arms)}")
-    return load_recordings(files, arm), arms[0]
+    return load_recordings(files, arm), single_arm(files, arm)
 
 
 def heldout_windows(rec: Recording, window: int, count: int, arm: str) -> torch.Tensor:
