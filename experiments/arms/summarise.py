@@ -73,15 +73,15 @@ def markdown(table: dict, sensing: str) -> str:
     lines = [
         f"### Cross-arm, sensing = {sensing} (held-out session of each arm, W = 32)",
         "",
-        "| arm | variant | seeds | own acc. | own loc. | unseen acc. | unseen loc. | "
-        "commissioned acc. | commissioned loc. | Δ acc. vs own | Δ loc. vs own | "
+        "| arm | variant | seeds (own / unseen) | own acc. | own loc. | unseen acc. | "
+        "unseen loc. | commissioned acc. | commissioned loc. | Δ acc. vs own | Δ loc. vs own | "
         "false alarms / healthy h |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for arm in ARMS:
         for variant in sorted({v for a, v in table if a == arm}):
             r = table[(arm, variant)]
-            seeds = max(len(r["own_acc"]), len(r["loao_acc"]))
+            seeds = f"{len(r['own_acc'])} / {len(r['loao_acc'])}"
             gap = [
                 _cell([np.mean(r[f"after_{k}"]) - np.mean(r[f"own_{k}"])])
                 if r[f"after_{k}"] and r[f"own_{k}"]
