@@ -65,6 +65,10 @@ def main() -> None:
             if scaled:
                 cells += [scaled["accuracy"], scaled["localisation_accuracy"]]
             rows.append(f"| {arm} | {variant} | " + " | ".join(f"{c:.3f}" for c in cells) + " |")
+    print(f"# Relative channels, ablated (seed {args.seed}, W = 32, leave-one-arm-out, before "
+          "commissioning)\n\n`python experiments/arms/raw_channels.py` (every arm read in its own "
+          "units: N m, rad/s) beside the\nrelative-channel runs of "
+          "`experiments/arms/campaign.py`.\n")  # fmt: skip
     print("| unseen arm | variant | raw acc. | raw loc. | relative acc. | relative loc. |")
     print("|---|---|---|---|---|---|")
     print("\n".join(rows))
