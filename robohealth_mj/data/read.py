@@ -20,6 +20,16 @@ from robohealth_mj.schema import GraphSample
 __all__ = ["is_bag", "is_log", "read_samples", "recording_arm", "recording_sensing"]
 
 
+def _manifest(path: Path) -> dict:
+    """The manifest beside a recording (``{}`` where there is none or it does not read)."""
+    manifest = (path if path.is_dir() else path.parent) / "manifest.json"
+    try:
+        data = json.loads(manifest.read_text())
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
 def recording_sensing(path: Path | str) -> str:
     """The sensing profile a recording carries: a controller log only the joint channels
     (``stock``), as does a bag without the sensor topics; a recording its manifest's
@@ -31,13 +41,7 @@ def recording_sensing(path: Path | str) -> str:
         from robohealth_mj.bags.reader import bag_sensing
 
         return bag_sensing(path)
-    manifest = (path if path.is_dir() else path.parent) / "manifest.json"
-    if manifest.is_file():
-        try:
-            return str(json.loads(manifest.read_text()).get("sensing", "full"))
-        except (ValueError, AttributeError):
-            return "full"
-    return "full"
+    return str(_manifest(path).get("sensing", "full"))
 
 
 def recording_arm(path: Path | str) -> str | None:
@@ -46,11 +50,7 @@ def recording_arm(path: Path | str) -> str | None:
     path = Path(path)
     if is_log(path) or is_bag(path):
         return None
-    manifest = (path if path.is_dir() else path.parent) / "manifest.json"
-    try:
-        ratings = json.loads(manifest.read_text()).get("arm_ratings") or {}
-    except (OSError, ValueError, AttributeError):
-        return None
+    ratings = _manifest(path).get("arm_ratings")
     arm = ratings.get("arm") if isinstance(ratings, dict) else None
     return str(arm) if arm else None
 
