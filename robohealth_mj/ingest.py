@@ -27,6 +27,8 @@ def _run(args: argparse.Namespace) -> int:
             f"{run_id}: {stats['rows']} rows at {stats['rate_hz']:g} Hz -> {stats['ticks']} ticks"
             f" at {args.tick_hz:g} Hz ({stats['ticks_in_gaps']} in gaps)"
         )
+    dropped = "; ".join(f"{c} dropped ({why})" for c, why in manifest["dropped"].items())
+    print(f"sensing profile {manifest['sensing']}" + (f": {dropped}" if dropped else ""))
     print(f"wrote {manifest['sample_count']} samples -> {Path(args.out) / 'graphs.jsonl'}")
     return 0
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from robohealth_mj.bags import is_bag
 from robohealth_mj.data.jsonl import read_jsonl_samples
-from robohealth_mj.logs import is_log, log_samples
+from robohealth_mj.logs import is_log, log_samples, log_sensing
 from robohealth_mj.schema import GraphSample
 
 __all__ = ["is_bag", "is_log", "read_samples", "recording_arm", "recording_sensing"]
@@ -31,12 +31,13 @@ def _manifest(path: Path) -> dict:
 
 
 def recording_sensing(path: Path | str) -> str:
-    """The sensing profile a recording carries: a controller log only the joint channels
-    (``stock``), as does a bag without the sensor topics; a recording its manifest's
-    ``sensing`` (the ingested logs' is ``stock``); a simulated one every channel (``full``)."""
+    """The sensing profile a recording carries: a controller log the joint channels its columns
+    give (``stock``, or ``stock_reduced`` without the target position), a bag without the sensor
+    topics ``stock``; a recording its manifest's ``sensing`` (an ingested log's says which); a
+    simulated one every channel (``full``)."""
     path = Path(path)
     if is_log(path):
-        return "stock"
+        return log_sensing(path)
     if is_bag(path):
         from robohealth_mj.bags.reader import bag_sensing
 

@@ -85,6 +85,20 @@ def load_profile(name: str) -> SensingProfile:
     return SensingProfile(**raw)
 
 
+def stock_profile_for(channels: Sequence[str], source: str) -> str:
+    """The shipped profile with no sensor package whose joint channels are exactly ``channels``
+    (how a controller log that lacks some channels is read); one line when none is."""
+    want = set(channels)
+    for path in sorted((conf_dir() / "sensing").glob("*.yaml")):
+        profile = load_profile(path.stem)
+        if not profile.sensor_nodes and set(profile.joint_channels) == want:
+            return profile.name
+    raise InputError(
+        f"{source}: no sensing profile reads exactly the joint channels {sorted(want)}: add one "
+        "to conf/sensing/ (joint_channels, no sensor_channels)"
+    )
+
+
 def refuse_missing_channels(model: str, data: str, source: str) -> None:
     """One line when data of profile ``data`` lacks channels a model of profile ``model`` reads
     (a stock model reads full recordings, a subset of them; a full model cannot read a log)."""

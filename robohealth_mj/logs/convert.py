@@ -57,15 +57,8 @@ def convert_log(
     """Read ``path`` through ``column_map`` (a name, a YAML path, or None: the shipped map whose
     columns the log has) and resample every session to ``tick_hz``."""
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"no log at {path}")
-    if isinstance(column_map, ColumnMap):
-        cmap = column_map
-    elif column_map is None:
-        cmap = detect_map(read_header(path), str(path))
-    else:
-        cmap = load_map(column_map)
-    table = read_table(path, cmap.needed())
+    cmap, header = resolve_map(path, column_map)
+    table = read_table(path, cmap.needed(), header)
     rows = np.arange(len(table.columns[cmap.time]))
     if not len(rows):
         raise InputError(f"{path}: no rows")
@@ -78,6 +71,34 @@ def convert_log(
     else:
         sessions.append((path.stem, rows))
     return cmap, [_session(table, cmap, run_id, idx, tick_hz, gap_s) for run_id, idx in sessions]
+
+
+def resolve_map(
+    path: Path, column_map: str | Path | ColumnMap | None = None
+) -> tuple[ColumnMap, list[str] | None]:
+    """The map ``path`` reads through, its optional channels the log lacks dropped, and the
+    column names of a table with no header line (None where the file has one)."""
+    if not path.is_file():
+        raise FileNotFoundError(f"no log at {path}")
+    first = read_header(path)
+    if isinstance(column_map, ColumnMap):
+        cmap = column_map
+    elif column_map is None:
+        cmap = detect_map(first, str(path))
+    else:
+        cmap = load_map(column_map)
+    header = cmap.header_of(first)
+    try:
+        cmap = cmap.for_header(header)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
+    return cmap, (header if header is not first else None)
+
+
+def log_sensing(path: Path | str, column_map: str | Path | ColumnMap | None = None) -> str:
+    """The sensing profile a log is read with: the channels its columns give (``stock`` for a
+    full RTDE log, ``stock_reduced`` for one without the target position, ...)."""
+    return resolve_map(Path(path), column_map)[0].sensing()
 
 
 def _session(
@@ -105,6 +126,8 @@ def _session(
     k_t = _torque_constants(table, cmap, idx)
     state = np.zeros((len(t), schema.N_JOINTS, len(schema.STATE_FEATURES)))
     for c, channel in enumerate(schema.STATE_FEATURES):
+        if channel not in cmap.channels:  # a channel this log lacks: zero, as the profile says
+            continue
         unit = cmap.units[channel]
         si, factor = UNITS[unit]
         for j in range(schema.N_JOINTS):
@@ -126,6 +149,8 @@ def _session(
         "ticks": len(at),
         "ticks_in_gaps": int((~keep).sum()),
         "torque_constant_nm_per_a": None if k_t is None else [round(float(v), 4) for v in k_t],
+        "sensing": cmap.sensing(),
+        "dropped": dict(cmap.dropped),
     }
     return LogSession(run_id, at, index.astype(np.int64), out.reshape(len(at), *state.shape[1:]),
                       stats)  # fmt: skip

@@ -36,7 +36,8 @@ def ingest(log: Path, column_map: str | None, out: Path, tick_hz: float) -> dict
         "source": str(log),
         "column_map": cmap.name,
         "column_map_file": cmap.source,
-        "sensing": "stock",
+        "sensing": cmap.sensing(),
+        "dropped": dict(cmap.dropped),  # channel -> why: channels the log cannot give
         "tick_hz": tick_hz,
         "labels": "none: a log has no ground truth",
         "sessions": {s.run_id: s.stats for s in sessions},

@@ -3,12 +3,15 @@
 A map is YAML (``conf/logmap/<name>.yaml``, or any file): the time column, an optional session
 column, the index that fills ``{j}`` in column names for each joint, per schema channel a column
 or ``[a, b]`` for ``a - b``, per channel a unit, and the torque constant for channels in amperes.
+A map may name the channels a log can lack (``optional``): such a log is read with the sensing
+profile of the channels it has (:func:`ColumnMap.for_header`), and names the columns of a table
+written without a header line (``header``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +49,9 @@ class ColumnMap:
     channels: dict[str, tuple[str, ...]]  # channel -> (column,) or (a, b) for a - b, with {j}
     units: dict[str, str]
     torque_constant: tuple[float, ...] | tuple[str, str] | None  # numbers, or fit columns
+    optional: tuple[str, ...] = ()  # channels a log may lack (it is then read without them)
+    header: tuple[str, ...] | None = None  # the column names of a table with no header line
+    dropped: dict[str, str] = field(default_factory=dict)  # channel -> why (for_header)
 
     def columns(self, channel: str, joint: int) -> tuple[str, ...]:
         return tuple(c.format(j=self.joint_index[joint]) for c in self.channels[channel])
@@ -66,8 +72,53 @@ class ColumnMap:
         return tc is not None and len(tc) == 2 and all(isinstance(c, str) for c in tc)
 
     def matches(self, header: Iterable[str]) -> bool:
+        """Whether a log with these columns reads through this map (optional channels aside)."""
+        return bool(self.for_header(header, strict=False))
+
+    def header_of(self, first_line: list[str]) -> list[str]:
+        """The column names of a table whose first line is ``first_line``: that line, or this
+        map's ``header`` where the line is numbers of as many fields (a table with no header)."""
+        if self.header and len(first_line) == len(self.header) and _numbers(first_line):
+            return list(self.header)
+        return first_line
+
+    def for_header(self, header: Iterable[str], strict: bool = True) -> ColumnMap | None:
+        """This map for a log with columns ``header``: each optional channel whose columns the
+        log lacks is dropped (``dropped`` says why). A required column missing: an InputError
+        naming it (``strict``) or None."""
         have = set(header)
-        return all(c in have for c in self.needed())
+        dropped = {}
+        for channel in self.optional:
+            gone = [c for j in range(schema.N_JOINTS) for c in self.columns(channel, j)
+                    if c not in have]  # fmt: skip
+            if gone:
+                dropped[channel] = f"column {gone[0]!r} missing"
+        kept = replace(
+            self,
+            channels={k: v for k, v in self.channels.items() if k not in dropped},
+            dropped=dropped,
+        )
+        missing = [c for c in kept.needed() if c not in have]
+        if not missing:
+            return kept
+        if strict:
+            raise InputError(f"column {missing[0]!r} missing ({len(missing)} missing in all)")
+        return None
+
+    def sensing(self) -> str:
+        """The sensing profile of the channels this map reads (no sensor package): the shipped
+        profile whose joint channels are exactly these."""
+        from robohealth_mj.data.sensing import stock_profile_for
+
+        return stock_profile_for(tuple(self.channels), self.source)
+
+
+def _numbers(cells: list[str]) -> bool:
+    try:
+        [float(c) for c in cells]
+    except ValueError:
+        return False
+    return bool(cells)
 
 
 def _fail(source: str, key: str, why: str) -> InputError:
@@ -106,6 +157,15 @@ def load_map(name_or_path: str | Path) -> ColumnMap:
     missing = [c for c in schema.STATE_FEATURES if c not in channels]
     if missing:
         raise _fail(src, "channels", f"{missing} missing: a stock model reads all five")
+    optional = tuple(raw.get("optional") or ())
+    unknown = [c for c in optional if c not in channels]
+    if unknown:
+        raise _fail(src, "optional", f"{unknown[0]!r} is not one of the map's channels")
+    header = raw.get("header")
+    if header is not None and (
+        not isinstance(header, list) or not all(isinstance(c, str) for c in header)
+    ):
+        raise _fail(src, "header", "the column names, in order, of a table with no header line")
     units = dict(raw["units"] or {})
     for channel in channels:
         unit = units.get(channel)
@@ -134,15 +194,18 @@ def load_map(name_or_path: str | Path) -> ColumnMap:
         channels=channels,
         units=units,
         torque_constant=tc,
+        optional=optional,
+        header=tuple(header) if header else None,
     )
 
 
 def detect_map(header: Iterable[str], source: str) -> ColumnMap:
-    """The shipped map whose columns the log has (the first, by name)."""
+    """The shipped map whose columns the log has (the first, by name); ``header`` is the log's
+    first line (a map with a ``header`` of its own reads a table that has none)."""
     header = list(header)
     for path in sorted(MAPS_DIR.glob("*.yaml")):
         cmap = load_map(path)
-        if cmap.matches(header):
+        if cmap.matches(cmap.header_of(header)):
             return cmap
     raise InputError(
         f"{source}: no column map fits its columns ({', '.join(header[:6])}, ...): "

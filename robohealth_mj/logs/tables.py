@@ -29,10 +29,12 @@ def read_header(path: Path) -> list[str]:
     return _split(line, _delimiter(line))
 
 
-def read_table(path: Path, names: list[str]) -> Table:
+def read_table(path: Path, names: list[str], header: list[str] | None = None) -> Table:
     """The named columns of ``path``; a missing column or a non-number is one line naming the
-    file, the column and the line (or row)."""
-    header = read_header(path)
+    file, the column and the line (or row). ``header``: the column names of a CSV written without
+    a header line (its first line is data)."""
+    headerless = header is not None
+    header = header if headerless else read_header(path)
     missing = [n for n in names if n not in header]
     if missing:
         raise InputError(f"{path}: column {missing[0]!r} missing ({len(missing)} missing in all)")
@@ -45,13 +47,15 @@ def read_table(path: Path, names: list[str]) -> Table:
             except (TypeError, ValueError):
                 raise InputError(f"{path}: column {name!r}: not numeric") from None
         return Table(str(path), columns, 1)
-    return _read_csv(path, header, names)
+    return _read_csv(path, header, names, headerless)
 
 
-def _read_csv(path: Path, header: list[str], names: list[str]) -> Table:
+def _read_csv(path: Path, header: list[str], names: list[str], headerless: bool) -> Table:
     with path.open(encoding="utf-8", errors="replace") as handle:
-        delimiter = _delimiter(handle.readline())
-        lines = handle.read().splitlines()
+        first = handle.readline()
+        delimiter = _delimiter(first)
+        lines = ([first] if headerless else []) + handle.read().splitlines()
+    first_line = 1 if headerless else 2
     index = [header.index(n) for n in names]
     values = np.empty((len(lines), len(names)))
     for row, line in enumerate(lines):
@@ -61,16 +65,18 @@ def _read_csv(path: Path, header: list[str], names: list[str]) -> Table:
                 values = values[:row]
                 break
             raise InputError(
-                f"{path}: line {row + 2}: {len(cells)} fields, the header has {len(header)}"
+                f"{path}: line {row + first_line}: {len(cells)} fields, the header has "
+                f"{len(header)}"
             )
         for k, i in enumerate(index):
             try:
                 values[row, k] = float(cells[i])
             except ValueError:
                 raise InputError(
-                    f"{path}: line {row + 2}: column {names[k]!r}: {cells[i]!r} is not a number"
+                    f"{path}: line {row + first_line}: column {names[k]!r}: {cells[i]!r} is not "
+                    "a number"
                 ) from None
-    return Table(str(path), {n: values[:, k] for k, n in enumerate(names)}, 2)
+    return Table(str(path), {n: values[:, k] for k, n in enumerate(names)}, first_line)
 
 
 def _delimiter(line: str) -> str | None:

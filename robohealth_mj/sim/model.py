@@ -42,13 +42,16 @@ def build_model(
     reference_torque_nm: list[float] | None = None,
     drive_overrides: dict | None = None,
     scene: Path | str = SCENE_XML,
+    twin: Path | str | None = None,
 ) -> mujoco.MjModel:
     """Compile arm ``arm`` in the scene at physics time step ``timestep``.
 
     ``drives``/``reference_torque_nm``: the drive model stated for the UR5e (default: the packaged
     config's); ``drive_overrides`` maps a joint name to any of ``armature``, ``damping``,
     ``frictionloss`` (motor side) and ``stiffness``, ``tendon_damping``, ``backlash`` (the drive
-    tendon), set after scaling to the arm.
+    tendon), set after scaling to the arm. ``twin``: an identified twin file of this arm
+    (``python -m robohealth_mj.identify``) whose drive parameters replace the scaled ones (before
+    ``drive_overrides``).
     """
     scene = Path(scene)
     if not scene.is_file():
@@ -62,6 +65,11 @@ def build_model(
     )
     description = load_arm(str(arm))
     per_joint = model.for_arm(description)
+    if twin:
+        from robohealth_mj.sim.twin_file import read_twin
+
+        for joint, params in read_twin(twin, str(arm)).items():
+            per_joint[joint].update(params)
     for joint, params in (drive_overrides or {}).items():
         if joint not in JOINT_NAMES:
             raise KeyError(

@@ -4,6 +4,7 @@ rebuilt here, not copied)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,7 @@ import pytest
 
 from robohealth_mj import schema
 from robohealth_mj.data.arrays import load_recordings
-from robohealth_mj.data.read import read_samples
+from robohealth_mj.data.read import read_samples, recording_sensing
 from robohealth_mj.ingest import main as ingest_main
 from robohealth_mj.logs.convert import convert_log
 
@@ -189,11 +190,12 @@ def test_each_bad_log_gets_one_line_naming_file_column_and_line(tmp_path, capsys
     assert "is the time in seconds?" in _bad(tmp_path, capsys, milliseconds)
     assert "column 'actual_qd_1': line 5: not a finite number" in _bad(tmp_path, capsys, nan)
 
-    def no_target(c):
-        del c["target_q_3"]
+    def no_current(c):
+        del c["actual_current_3"]
 
-    assert "column 'target_q_3' missing" in _bad(tmp_path, capsys, no_target, "--map", "ur_rtde")
-    assert "no column map fits its columns" in _bad(tmp_path, capsys, no_target)
+    err = _bad(tmp_path, capsys, no_current, "--map", "ur_rtde")
+    assert "column 'actual_current_3' missing" in err
+    assert "no column map fits its columns" in _bad(tmp_path, capsys, no_current)
     spec = tmp_path / "odd.yaml"
     spec.write_text("time: t\njoint_index: [0,1,2,3,4,5]\nchannels: {torque: x}\nunits: {}\n")
     assert "key 'channels.torque': unknown" in _bad(
@@ -253,3 +255,46 @@ def test_a_stock_model_diagnoses_a_log_as_it_diagnoses_the_recording(
     err = capsys.readouterr().err.strip()
     assert done.value.code == 2 and "\n" not in err
     assert "arm.csv: the data has the stock profile's channels and the model reads the full" in err
+
+
+def test_a_log_without_target_position_is_read_with_the_reduced_profile(tmp_path, capsys):
+    """A real RTDE log without ``target_q``: ingest picks stock_reduced, says what it dropped
+    and why, zeroes the tracking error and keeps every other channel as the full log has it."""
+    t = np.arange(0, 4.0, 1 / 125.0)
+    full = _rtde(t)
+    cols = {k: v for k, v in full.items() if not k.startswith("target_q_")}
+    log = _write_csv(tmp_path / "no_target.csv", cols, ",")
+    assert ingest_main([str(log), "--out", str(tmp_path / "rec")]) == 0
+    out = capsys.readouterr().out
+    assert "sensing profile stock_reduced: pos_error dropped (column 'target_q_0' missing)" in out
+    manifest = json.loads((tmp_path / "rec" / "manifest.json").read_text())
+    assert manifest["sensing"] == "stock_reduced" and "pos_error" in manifest["dropped"]
+    assert recording_sensing(log) == "stock_reduced"
+    assert recording_sensing(_write_csv(tmp_path / "full.csv", full, ",")) == "stock"
+    reduced = load_recordings([log]).x
+    whole = load_recordings([tmp_path / "full.csv"]).x
+    err = schema.feature_index("pos_error")
+    assert not reduced[..., err].any() and whole[:, :J, err].any()
+    keep = [schema.feature_index(n) for n in ("pos", "vel", "effort", "effort_residual")]
+    np.testing.assert_allclose(reduced[..., keep], whole[..., keep], rtol=1e-6)
+
+
+def test_a_headerless_log_reads_through_the_map_that_names_its_columns(tmp_path, capsys):
+    """The public UR10e identification layout: 31 numbers a row, no header line."""
+    t = np.arange(0, 3.0, 1 / 100.0)
+    cols = _rtde(t)
+    order = ["timestamp"] + [f"{c}_{j}" for c in ("actual_q", "actual_qd", "actual_current",
+                                                  "target_current", "target_moment")
+                             for j in range(J)]  # fmt: skip
+    log = tmp_path / "ur-20_01_17-p1.csv"
+    log.write_text("\n".join(",".join(f"{cols[n][i]:.9g}" for n in order)
+                             for i in range(len(t))) + "\n")  # fmt: skip
+    cmap, (session,) = convert_log(log)
+    assert cmap.name == "ur_rtde_headerless" and session.stats["sensing"] == "stock_reduced"
+    assert session.stats["rows"] == len(t)  # the first line is data, not a header
+    np.testing.assert_allclose(session.state[:, 0, 0], cols["actual_q_0"][::5], atol=1e-7)
+    lines = log.read_text().splitlines()
+    lines[7] = lines[7].replace(",", ",x", 1)
+    log.write_text("\n".join(lines) + "\n")
+    assert ingest_main([str(log), "--out", str(tmp_path / "bad")]) == 2
+    assert "line 8: column 'actual_q_0': 'x" in capsys.readouterr().err

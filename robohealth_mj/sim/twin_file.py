@@ -1,0 +1,53 @@
+"""The twin file: an arm's identified drive parameters, as the simulator reads them.
+
+YAML with the arm it is of, per joint the drive parameters that replace the simulator's
+(``drive_overrides``: rotor inertia, viscous and Coulomb friction), the torque constants, the
+logs it was fitted on and the fit's residuals. ``sim.twin=FILE`` (with ``arm=`` the same arm)
+makes every simulation run on it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+from robohealth_mj.common.atomic import atomic_write_text
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.schema import JOINT_NAMES
+
+PARAMETERS = ("armature", "damping", "frictionloss")  # what identification fits per joint
+
+
+def write_twin(path: Path, content: dict) -> None:
+    atomic_write_text(path, yaml.safe_dump(content, sort_keys=False))
+
+
+def read_twin(path: Path | str, arm: str) -> dict[str, dict[str, float]]:
+    """The drive overrides of twin file ``path``, which must be of ``arm``; one line otherwise."""
+    path = Path(path)
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except OSError as exc:
+        raise InputError(f"sim.twin: {path}: {exc.strerror}") from None
+    except yaml.YAMLError as exc:
+        raise InputError(f"sim.twin: {path}: not YAML ({str(exc).splitlines()[0]})") from None
+    if not isinstance(raw, dict) or "drive_overrides" not in raw:
+        raise InputError(f"{path}: key 'drive_overrides': missing (not a twin file?)")
+    if raw.get("arm") != arm:
+        raise InputError(f"{path}: key 'arm': the twin is of {raw.get('arm')!r} and the "
+                         f"simulation's arm is {arm!r}: pass arm={raw.get('arm')}")  # fmt: skip
+    overrides = raw["drive_overrides"]
+    out = {}
+    for joint in JOINT_NAMES:
+        params = (overrides or {}).get(joint)
+        if not isinstance(params, dict):
+            raise InputError(f"{path}: key 'drive_overrides.{joint}': missing")
+        out[joint] = {}
+        for name in PARAMETERS:
+            value = params.get(name)
+            if not isinstance(value, (int, float)) or not value >= 0:
+                raise InputError(f"{path}: key 'drive_overrides.{joint}.{name}': a number >= 0, "
+                                 f"got {value!r}")  # fmt: skip
+            out[joint][name] = float(value)
+    return out

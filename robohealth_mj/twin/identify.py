@@ -1,0 +1,197 @@
+"""Identifying a real arm's drives from its controller log.
+
+The simulated arm of the log's type is driven along the logged joint trajectory: MuJoCo's inverse
+dynamics of its compiled model (links from UR's published parameters) give the rigid-body torque
+each joint needs at each row. What our drive model adds per joint is linear in its parameters,
+
+    tau = rigid(q, qd, qdd) + armature * qdd + damping * qd + frictionloss * sign(qd)
+
+and the log measures it twice: the controller's own model torque (``target_moment``, which has no
+friction) and the motor current, ``i = tau / k_t``. So, per joint, by non-negative least squares:
+the rotor inertia from the model torque (where the log has one), then ``i`` on ``[rigid +
+armature * qdd, qd, sign(qd)]``, whose coefficients are ``1/k_t``, ``damping/k_t`` and
+``frictionloss/k_t`` (with no model torque in the log the rotor inertia joins that fit). The
+velocity is low-passed without phase lag and differentiated for the acceleration.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+from scipy.optimize import nnls
+from scipy.signal import butter, filtfilt
+
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.schema import JOINT_NAMES
+from robohealth_mj.sim.model import ArmIndex, build_model
+from robohealth_mj.sim.twin_file import PARAMETERS
+from robohealth_mj.twin.joint_log import JointLog
+
+SIGN_VELOCITY = 0.02  # rad/s: sign(qd) as tanh(qd / this), so friction is smooth through rest
+CUTOFF_HZ = 10.0  # the velocity's low-pass before differentiation (zero phase)
+
+
+@dataclass
+class Motion:
+    """A log's trajectory as identification uses it: ``[T, 6]`` each."""
+
+    q: np.ndarray
+    qd: np.ndarray  # low-passed, zero phase
+    qdd: np.ndarray  # of the low-passed velocity
+    sign: np.ndarray  # tanh(qd / SIGN_VELOCITY)
+
+
+def motion(log: JointLog) -> Motion:
+    rate = log.rate_hz
+    b, a = butter(2, min(CUTOFF_HZ, 0.4 * rate) / (0.5 * rate))
+    qd = filtfilt(b, a, log.qd, axis=0) if len(log.t) > 15 else log.qd
+    qdd = np.gradient(qd, log.t, axis=0)
+    return Motion(log.q, qd, qdd, np.tanh(qd / SIGN_VELOCITY))
+
+
+def rigid_torques(arm: str, m: Motion, payload_kg: float = 0.0) -> np.ndarray:
+    """``[T, 6]`` the links' torque along the motion on the simulated ``arm`` (UR's published
+    inertials; no drive: its armature and damping are taken out, friction is off)."""
+    model = build_model(arm)
+    model.opt.disableflags |= (
+        mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS
+        | mujoco.mjtDisableBit.mjDSBL_CONTACT
+        | mujoco.mjtDisableBit.mjDSBL_LIMIT
+    )
+    idx = ArmIndex.of(model)
+    model.body_mass[idx.payload_body] = payload_kg
+    data = mujoco.MjData(model)
+    out = np.empty_like(m.q)
+    for k in range(len(m.q)):
+        data.qpos[idx.motor_qpos] = m.q[k]
+        data.qpos[idx.deflection_qpos] = 0.0
+        data.qvel[:] = 0.0
+        data.qvel[idx.motor_dof] = m.qd[k]
+        data.qacc[:] = 0.0
+        data.qacc[idx.motor_dof] = m.qdd[k]
+        mujoco.mj_inverse(model, data)
+        out[k] = data.qfrc_inverse[idx.motor_dof]
+    dof = idx.motor_dof
+    return out - model.dof_armature[dof] * m.qdd - model.dof_damping[dof] * m.qd
+
+
+@dataclass
+class Drives:
+    """Per joint (schema order) drive parameters and torque constant."""
+
+    armature: np.ndarray
+    damping: np.ndarray
+    frictionloss: np.ndarray
+    torque_constant: np.ndarray | None = None  # N*m per A; None: not identified (nominal)
+
+    def model_torque(self, rigid: np.ndarray, m: Motion) -> np.ndarray:
+        """What a controller's model computes: rigid body and rotor inertia, no friction."""
+        return rigid + self.armature * m.qdd
+
+    def torque(self, rigid: np.ndarray, m: Motion) -> np.ndarray:
+        """The drive's whole torque: the model torque and friction, viscous and Coulomb."""
+        return self.model_torque(rigid, m) + self.damping * m.qd + self.frictionloss * m.sign
+
+    def overrides(self) -> dict[str, dict[str, float]]:
+        return {
+            joint: {p: round(float(getattr(self, p)[j]), 6) for p in PARAMETERS}
+            for j, joint in enumerate(JOINT_NAMES)
+        }
+
+
+def nominal_drives(arm: str) -> Drives:
+    """The simulator's drive parameters for ``arm`` before identification."""
+    model = build_model(arm)
+    dof = ArmIndex.of(model).motor_dof
+    return Drives(model.dof_armature[dof].copy(), model.dof_damping[dof].copy(),
+                  model.dof_frictionloss[dof].copy())  # fmt: skip
+
+
+@dataclass
+class Identified:
+    drives: Drives
+    rows: int
+    seconds: float
+    used_model_torque: bool
+    notes: list[str] = field(default_factory=list)
+
+
+def identify(arm: str, logs: Sequence[JointLog]) -> Identified:
+    """Each joint's rotor inertia, viscous and Coulomb friction and torque constant, fitted on
+    ``logs`` (healthy running, no payload) pooled."""
+    if not logs:
+        raise InputError("identify: no log to fit on")
+    motions = [motion(log) for log in logs]
+    rigid = np.concatenate([rigid_torques(arm, m) for m in motions])
+    qdd = np.concatenate([m.qdd for m in motions])
+    qd = np.concatenate([m.qd for m in motions])
+    sign = np.concatenate([m.sign for m in motions])
+    current = np.concatenate([log.current for log in logs])
+    with_model = all(log.model_torque is not None for log in logs)
+    model_torque = np.concatenate([log.model_torque for log in logs]) if with_model else None
+    armature, damping, friction, k_t = (np.zeros(len(JOINT_NAMES)) for _ in range(4))
+    notes = []
+    for j, joint in enumerate(JOINT_NAMES):
+        if np.ptp(qd[:, j]) < 1e-3:
+            raise InputError(f"identify: joint {joint} does not move in the fit logs")
+        if with_model:
+            armature[j] = nnls(qdd[:, [j]], model_torque[:, j] - rigid[:, j])[0][0]
+            columns = [rigid[:, j] + armature[j] * qdd[:, j], qd[:, j], sign[:, j]]
+        else:
+            columns = [rigid[:, j], qdd[:, j], qd[:, j], sign[:, j]]
+        coef = nnls(np.stack(columns, axis=1), current[:, j])[0]
+        if coef[0] <= 0:
+            raise InputError(f"identify: joint {joint}: current does not follow the torque; is "
+                             "the effort column a current of this joint?")  # fmt: skip
+        k_t[j] = 1.0 / coef[0]
+        if not with_model:
+            armature[j] = coef[1] * k_t[j]
+            coef = np.delete(coef, 1)
+        damping[j], friction[j] = coef[1] * k_t[j], coef[2] * k_t[j]
+    if not with_model:
+        notes.append("no model torque in the logs: rotor inertia fitted on the current")
+    rows = len(current)
+    seconds = float(sum(log.t[-1] - log.t[0] for log in logs))
+    return Identified(Drives(armature, damping, friction, k_t), rows, seconds, with_model, notes)
+
+
+def nrmse(simulated: np.ndarray, measured: np.ndarray) -> np.ndarray:
+    """``[6]`` RMS error over the measured signal's range on that log (per joint)."""
+    span = np.ptp(measured, axis=0)
+    return np.sqrt(np.mean((simulated - measured) ** 2, axis=0)) / np.where(span > 0, span, 1.0)
+
+
+def friction_floor(logs: Sequence[JointLog]) -> tuple[np.ndarray, np.ndarray]:
+    """The controller's own model as a current predictor: per joint, ``i`` on ``[target moment,
+    qd, sign(qd)]`` fitted on ``logs``; ``([6, 3] coefficients, [6] torque constants)``."""
+    motions = [motion(log) for log in logs]
+    tau = np.concatenate([log.model_torque for log in logs])
+    qd = np.concatenate([m.qd for m in motions])
+    sign = np.concatenate([m.sign for m in motions])
+    current = np.concatenate([log.current for log in logs])
+    coef = np.stack([nnls(np.stack([tau[:, j], qd[:, j], sign[:, j]], 1), current[:, j])[0]
+                     for j in range(len(JOINT_NAMES))])  # fmt: skip
+    return coef, 1.0 / np.where(coef[:, 0] > 0, coef[:, 0], np.nan)
+
+
+def fidelity(arm: str, log: JointLog, drives: Drives, floor: np.ndarray | None = None) -> dict:
+    """NRMSE per joint of the simulated torque against the log's: the model torque against the
+    controller's target moment, the whole torque against current x k_t (``drives``' k_t), and
+    the floor (target moment and fitted friction against the same) where ``floor`` is given."""
+    m = motion(log)
+    rigid = rigid_torques(arm, m)
+    k_t = drives.torque_constant
+    out = {"log": log.name, "seconds": round(float(log.t[-1]), 1)}
+    if log.model_torque is not None:
+        out["vs_target_moment"] = nrmse(drives.model_torque(rigid, m), log.model_torque)
+    if k_t is not None:
+        measured = log.current * k_t
+        out["vs_current"] = nrmse(drives.torque(rigid, m), measured)
+        if floor is not None and log.model_torque is not None:
+            coef, k_floor = floor
+            predicted = coef[:, 0] * log.model_torque + coef[:, 1] * m.qd + coef[:, 2] * m.sign
+            out["floor_vs_current"] = nrmse(predicted * k_floor, log.current * k_floor)
+    return out
