@@ -105,15 +105,8 @@ def _session(
     table: Table, cmap: ColumnMap, run_id: str, idx: np.ndarray, tick_hz: float, gap_s: float | None
 ) -> LogSession:
     src = table.source
-    t = _checked(table, cmap.time, idx, None)
+    t = checked_time(table, cmap, idx)
     dt = np.diff(t)
-    back = np.flatnonzero(dt <= 0)
-    if back.size:
-        k = idx[back[0] + 1]
-        raise InputError(
-            f"{src}: column {cmap.time!r}: {table.row_name(k)}: time {t[back[0] + 1]:.6g} is "
-            f"not after the row before ({t[back[0]]:.6g}): time must increase"
-        )
     if len(t) < 2:
         raise InputError(f"{src}: session {run_id}: one row; a log needs at least two")
     period = float(np.median(dt))
@@ -132,7 +125,7 @@ def _session(
         si, factor = UNITS[unit]
         for j in range(schema.N_JOINTS):
             cols = cmap.columns(channel, j)
-            values = [_checked(table, col, idx, si, factor) for col in cols]
+            values = [checked_column(table, col, idx, si, factor) for col in cols]
             series = values[0] - values[1] if len(values) == 2 else values[0]
             state[:, j, c] = series * (k_t[j] if si == "A" else 1.0)
     gap = 3.0 * period if gap_s is None else float(gap_s)
@@ -156,7 +149,21 @@ def _session(
                       stats)  # fmt: skip
 
 
-def _checked(
+def checked_time(table: Table, cmap: ColumnMap, idx: np.ndarray) -> np.ndarray:
+    """The time column's rows ``idx``, refused at the first row not after the one before."""
+    t = checked_column(table, cmap.time, idx, None)
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if back.size:
+        k = idx[back[0] + 1]
+        raise InputError(
+            f"{table.source}: column {cmap.time!r}: {table.row_name(k)}: time "
+            f"{t[back[0] + 1]:.6g} is not after the row before ({t[back[0]]:.6g}): time must "
+            "increase"
+        )
+    return t
+
+
+def checked_column(
     table: Table, column: str, idx: np.ndarray, si: str | None, factor: float = 1.0
 ) -> np.ndarray:
     """The column's rows ``idx`` in SI, refused at the first NaN or value no arm reports."""
@@ -186,8 +193,8 @@ def _torque_constants(table: Table, cmap: ColumnMap, idx: np.ndarray) -> np.ndar
     moment_col, current_col = cmap.torque_constant
     out = np.empty(schema.N_JOINTS)
     for j, name in enumerate(cmap.joint_index):
-        moment = _checked(table, moment_col.format(j=name), idx, "N*m")
-        current = _checked(table, current_col.format(j=name), idx, "A")
+        moment = checked_column(table, moment_col.format(j=name), idx, "N*m")
+        current = checked_column(table, current_col.format(j=name), idx, "A")
         energy = float(current @ current)
         if energy < 1e-9 * len(current):
             raise InputError(

@@ -13,7 +13,8 @@ from robohealth_mj.sim.model import ArmIndex, build_model
 
 
 @lru_cache(maxsize=8)
-def _nominal(arm: str) -> tuple[mujoco.MjModel, ArmIndex]:
+def nominal_model(arm: str) -> tuple[mujoco.MjModel, ArmIndex]:
+    """The arm's compiled nominal model, built once (callers edit a ``copy.copy`` of it)."""
     model = build_model(arm)
     return model, ArmIndex.of(model)
 
@@ -28,7 +29,7 @@ def gravity_torques(q: np.ndarray, payload_kg: float = 0.0, arm: str = DEFAULT_A
         raise ValueError(f"q must have shape (6,), got {q.shape}")
     if payload_kg < 0:
         raise ValueError(f"payload_kg must be >= 0, got {payload_kg}")
-    model, index = _nominal(arm)
+    model, index = nominal_model(arm)
     local = copy.copy(model)  # the cached nominal model is never edited
     local.body_mass[index.payload_body] = payload_kg
     data = mujoco.MjData(local)

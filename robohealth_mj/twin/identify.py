@@ -16,6 +16,7 @@ velocity is low-passed without phase lag and differentiated for the acceleration
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -26,7 +27,7 @@ from scipy.signal import butter, filtfilt
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
-from robohealth_mj.sim.model import ArmIndex, build_model
+from robohealth_mj.sim.dynamics import nominal_model
 from robohealth_mj.sim.twin_file import PARAMETERS
 from robohealth_mj.twin.joint_log import JointLog
 
@@ -55,13 +56,13 @@ def motion(log: JointLog) -> Motion:
 def rigid_torques(arm: str, m: Motion, payload_kg: float = 0.0) -> np.ndarray:
     """``[T, 6]`` the links' torque along the motion on the simulated ``arm`` (UR's published
     inertials; no drive: its armature and damping are taken out, friction is off)."""
-    model = build_model(arm)
+    nominal, idx = nominal_model(arm)
+    model = copy.copy(nominal)  # the cached model is never edited
     model.opt.disableflags |= (
         mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS
         | mujoco.mjtDisableBit.mjDSBL_CONTACT
         | mujoco.mjtDisableBit.mjDSBL_LIMIT
     )
-    idx = ArmIndex.of(model)
     model.body_mass[idx.payload_body] = payload_kg
     data = mujoco.MjData(model)
     out = np.empty_like(m.q)
@@ -104,8 +105,8 @@ class Drives:
 
 def nominal_drives(arm: str) -> Drives:
     """The simulator's drive parameters for ``arm`` before identification."""
-    model = build_model(arm)
-    dof = ArmIndex.of(model).motor_dof
+    model, idx = nominal_model(arm)
+    dof = idx.motor_dof
     return Drives(model.dof_armature[dof].copy(), model.dof_damping[dof].copy(),
                   model.dof_frictionloss[dof].copy())  # fmt: skip
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.logs.convert import _checked, resolve_map
+from robohealth_mj.logs.convert import checked_column, checked_time, resolve_map
 from robohealth_mj.logs.maps import CHANNEL_UNIT, UNITS
 from robohealth_mj.logs.tables import read_header, read_table
 
@@ -57,15 +57,12 @@ def read_joint_log(path: Path | str, column_map: str | None = None) -> JointLog:
     rows = np.arange(len(table.columns[cmap.time]))
     if len(rows) < 10:
         raise InputError(f"{path}: {len(rows)} rows; identification needs a trajectory")
-    t = _checked(table, cmap.time, rows, None)
-    back = np.flatnonzero(np.diff(t) <= 0)
-    if back.size:
-        raise InputError(f"{path}: column {cmap.time!r}: {table.row_name(int(back[0]) + 1)}: "
-                         "time must increase")  # fmt: skip
+    t = checked_time(table, cmap, rows)
 
     def channel(col: str, si: str, factor: float = 1.0) -> np.ndarray:
         return np.stack(
-            [_checked(table, col.format(j=i), rows, si, factor) for i in cmap.joint_index], axis=1
+            [checked_column(table, col.format(j=i), rows, si, factor) for i in cmap.joint_index],
+            axis=1,
         )
 
     def signal(name: str) -> np.ndarray:  # the channel's own column (not a difference)
