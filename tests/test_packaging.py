@@ -195,7 +195,7 @@ LAYERS = (
     ("sim",),
     ("faults",),
     ("data", "logs", "bags"),  # recordings on disk, controller logs and bags: one layer of readers
-    ("recording",),
+    ("recording", "twin"),  # simulating sessions; identifying a real arm's twin from its logs
     ("models",),
     ("learn",),
     ("runtime",),  # torch-free streaming
