@@ -3,12 +3,26 @@ corpus on the twin, train the stock_reduced profile's models on it, commission t
 real logs and monitor the arm's other real logs.
 
     experiments/real_arms/fetch.sh                   # the logs -> outputs/real_arms/logs/
-    python experiments/real_arms/campaign.py [--variants gbdt,stgnn_fixed] [--seed 42] [--epochs 10]
+    python experiments/real_arms/campaign.py [--curriculum standard|replay|mixed]
+        [--commission jointwise|jointwise+program] [--twin FILE] [--name RUN]
+        [--variants gbdt,stgnn_fixed] [--seed 42] [--epochs 10]
 
-Writes under ``outputs/real_arms/``: ``twin/`` (twin.yaml, fidelity.md), the corpus
-``outputs/corpus/real_ur10e``, the models ``models/``, per model and log the monitor's verdict
-(``verdicts/``), and prints the tables ``results/real_arms/`` keeps. Every step skips what is
-done. Logs: which fits, which commissions and which are monitored is fixed below (``LOGS``).
+``--curriculum standard`` trains on our sweeps and payloads (the quick corpus on the twin);
+``replay`` on the arm's own program: the ``program`` logs replayed on the twin with no payload
+(``conf/corpus/replay.yaml``, ``curriculum=replay``); ``mixed`` on both corpora. ``--commission``
+names the healthy real running the models are commissioned on. Writes under
+``outputs/real_arms/``: ``twin/`` (twin.yaml, fidelity.md), the corpora
+``outputs/corpus/real_ur10e_<curriculum>``, and per run (``--name``, default the curriculum) the
+models ``<run>/models/`` and per model and log the monitor's verdict (``<run>/verdicts/``). Every
+step skips what is done. ``--swap VARIANT`` prints where the real arm's healthy running looks
+faulty to a commissioned network, and why: each monitored log's motion is replayed on the healthy
+twin (tick for tick the same motion), and the network reads the real ticks, the simulated ticks,
+and the real ticks with one channel (or one joint's torque residual) taken from the simulation.
+A swap that brings the real share of ticks called faulty to the simulated one names where twin and
+arm differ; a simulated share as high as the real one says the model calls this motion faulty in
+simulation too (a gap between training program and motion, not between simulation and arm).
+Which log fits, is replayed, commissions or is monitored is fixed below (``LOGS_ROLES``): the
+monitored healthy logs are none of the others.
 """
 
 from __future__ import annotations
@@ -19,10 +33,19 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+
+from robohealth_mj import schema
+from robohealth_mj.runtime.runtime import ModelRuntime
+from robohealth_mj.runtime.sources import replay_stream
+
 ROOT = Path("outputs/real_arms")
 LOGS = ROOT / "logs"
-CORPUS = Path("outputs/corpus/real_ur10e")
 ID = LOGS / "identification_data"
+VAL = LOGS / "validation_data"
+# The twin stands on a 0.8 m pedestal: these logs take the arm's links down to 0.6 m below its
+# base plane (forward kinematics of every log, bounding spheres), where our floor would stop them.
+MOUNT_M = 0.8
 LOGS_ROLES = {
     # identification: three excitation trajectories (12 harmonics), about 2.5 min
     "fit": [
@@ -41,15 +64,47 @@ LOGS_ROLES = {
     ],
     # commissioning: one joint at a time, each through its range (6.8 min)
     "commission": sorted((LOGS / "jointwise_motion").glob("*.csv")),
+    # the arm's program for curriculum=replay: the other excitation runs without payload (5.6 min)
+    "program": [
+        ID / f
+        for f in (
+            "ur-19_09_27-15_11_06.csv",
+            "ur-19_10_01-13_51_41.csv",
+            "ur-19_10_01-14_04_13.csv",
+            "ur-19_10_01-14_04_41.csv",
+            "ur-20_02_05-20sec_12harm.csv",
+            "ur-20_02_05-20sec_8harm.csv",
+            "ur-20_02_06-20sec_10harm.csv",
+            "ur-20_02_06-20sec_5harm.csv",
+            "ur-20_02_10-20sec_7harm.csv",
+            "ur-20_02_10-30sec_12harm.csv",
+            "ur-20_02_12-40sec_12harm.csv",
+            "ur-20_02_12-50sec_12harm.csv",
+        )
+    ],
 }
 
 
+# the corpora each curriculum trains on (the last one's held-out session is the one evaluated)
+CURRICULA = {"standard": ["standard"], "replay": ["replay"], "mixed": ["standard", "replay"]}
+# the healthy real running each model is commissioned on
+COMMISSION = {"jointwise": ["commission"], "jointwise+program": ["commission", "program"]}
+
+
 def healthy_monitored() -> list[Path]:
-    """Every healthy real log not used to commission, with no payload, that ingests."""
-    unreadable = {"ur-19_09_27-11_28_22.csv", "ur-19_09_27-11_32_02.csv",  # another layout
-                  "ur-20_02_19_15harm50secLoad.csv"}  # fmt: skip  # a corrupt file
-    logs = sorted(ID.glob("*.csv")) + sorted((LOGS / "validation_data").glob("*.csv"))
-    return [p for p in logs if p.name not in unreadable and "load" not in p.name.lower()]
+    """The healthy real logs without payload that neither commission nor are replayed: unseen
+    excitation runs, a free motion, a run after unloading, point-to-point moves and ten holds."""
+    # the short layout (no target current: joint_states, not the stock_reduced models' profile)
+    # and a corrupt file
+    unreadable = {"ur-19_09_27-11_28_22.csv", "ur-19_09_27-11_32_02.csv",
+                  "ur-20_02_19_15harm50secLoad.csv"}  # fmt: skip
+    used = {p.name for role in LOGS_ROLES.values() for p in role} - {
+        p.name
+        for p in LOGS_ROLES["validate"]  # fidelity logs: not fitted, so unseen here too
+    }
+    logs = sorted(ID.glob("*.csv")) + sorted(VAL.glob("*.csv"))
+    payload = [p.name for p in logs if "load" in p.name.lower() and "unload" not in p.name]
+    return [p for p in logs if p.name not in unreadable | used | set(payload)]
 
 
 def events() -> dict[str, list[Path]]:
@@ -69,36 +124,142 @@ def as_list(paths: list[Path]) -> str:
     return "[" + ",".join(str(p) for p in paths) + "]"
 
 
+def record_corpus(curriculum: str, twin: Path, tag: str) -> Path:
+    """The quick-size corpus of ``curriculum`` on ``twin`` (recorded once)."""
+    corpus = Path(f"outputs/corpus/real_ur10e_{curriculum}{tag}")
+    overrides = ["arm=ur10e", f"sim.twin={twin}", f"sim.mount_height_m={MOUNT_M}"]
+    if curriculum == "replay":
+        overrides += ["curriculum=replay", f"curriculum.files={as_list(LOGS_ROLES['program'])}"]
+    if not (corpus / "corpus.json").is_file():
+        config = "replay" if curriculum == "replay" else "quick"
+        run("robohealth_mj.corpus", f"corpus={config}", f"out_dir={corpus}",
+            f"record_overrides={json.dumps(overrides)}", "progress=false")  # fmt: skip
+    return corpus
+
+
+CHANNELS = ("pos", "vel", "effort", "effort_residual")
+LEAD_S = 1.5  # the replay's first move (from rest to the log's first pose) before the log plays
+
+
+def simulated(log: Path, twin: Path, out: Path) -> Path:
+    """The log's motion replayed on the healthy twin (recorded once)."""
+    graphs = out / "graphs.jsonl"
+    if not graphs.is_file():
+        seconds = float(np.loadtxt(log, delimiter=",", usecols=0, ndmin=1)[[0, -1]] @ [-1, 1])
+        subprocess.run([sys.executable, "-m", "robohealth_mj.record", "arm=ur10e",
+                        f"sim.twin={twin}", f"sim.mount_height_m={MOUNT_M}", "curriculum=replay",
+                        f"curriculum.files=[{log}]", "curriculum.passes=1", "curriculum.hold_s=0",
+                        "faults=none", f"session.duration_s={seconds + LEAD_S + 0.5:.2f}",
+                        "seed=1", f"session.out_dir={out}", "session.progress=false"],
+                       check=True, stdout=subprocess.DEVNULL)  # fmt: skip
+    return graphs
+
+
+def share(model: Path, xs: list[np.ndarray], like: list[schema.GraphSample]) -> float:
+    """Share of decided ticks called faulty when the monitor reads ``xs`` in ``like``'s place."""
+    runtime = ModelRuntime(str(model))
+    decided = faulty = 0
+    for x, s in zip(xs, like, strict=True):
+        d = runtime.process("arm", schema.GraphSample(s.recording_run_id, s.sample_index, s.t, x,
+                                                      s.fault, s.segment))  # fmt: skip
+        if d.valid and d.fault_class is not None:
+            decided += 1
+            faulty += bool(d.fault_present)
+    return faulty / max(decided, 1)
+
+
+def swap_table(run_name: str, variant: str) -> None:
+    """Prints the channel-swap table (see ``--swap``) for ``variant`` of run ``run_name``."""
+    models = ROOT / run_name / "models"
+    model = next(p for p in models.rglob("commissioned/model.onnx") if variant in p.parts)
+    twin = ROOT / "twin" / "twin.yaml"
+    residual = schema.feature_index("effort_residual")
+    short = ("pan", "lift", "elbow", "w1", "w2", "w3")
+    print(f"## Channel swaps: {variant}, run {run_name} (share of ticks called faulty)\n")
+    heads = [f"real, sim {c}" for c in CHANNELS] + [f"real, sim residual {j}" for j in short]
+    print("| log | real | sim, same motion | " + " | ".join(heads) + " |")
+    print("|---" * (3 + len(heads)) + "|")
+    for log in healthy_monitored():
+        real = [s for _, s, _ in replay_stream(str(log))]
+        sim = [s for _, s, _ in replay_stream(str(simulated(log, twin, ROOT / "swap" / log.stem)))]
+        t_sim = np.array([s.t for s in sim]) - LEAD_S  # the log's first row plays at LEAD_S
+        t_real = np.array([s.t for s in real]) - real[0].t
+        at = np.clip(np.searchsorted(t_sim, t_real - 1e-6), 0, len(sim) - 1)
+        real_x = [s.x for s in real]
+        sim_x = [sim[k].x for k in at]
+        cells = [share(model, real_x, real), share(model, sim_x, real)]
+        for c in CHANNELS:
+            f = schema.feature_index(c)
+            cells.append(share(model, [_swap(r, s, slice(0, 6), f) for r, s in
+                                       zip(real_x, sim_x, strict=True)], real))  # fmt: skip
+        for j in range(schema.N_JOINTS):
+            cells.append(share(model, [_swap(r, s, slice(j, j + 1), residual) for r, s in
+                                       zip(real_x, sim_x, strict=True)], real))  # fmt: skip
+        print(f"| {log.stem} | " + " | ".join(f"{v:.2f}" for v in cells)
+              + " |")  # fmt: skip
+
+
+def _swap(real: np.ndarray, sim: np.ndarray, joints: slice, feature: int) -> np.ndarray:
+    """The real snapshot with ``feature`` of ``joints`` taken from the simulated one."""
+    x = real.copy()
+    x[joints, feature] = sim[joints, feature]
+    return x
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--variants", default="gbdt,stgnn_fixed")
     parser.add_argument("--seed", default="42")
     parser.add_argument("--epochs", type=int, default=10)
-    parser.add_argument("--corpus", default="quick")
-    args = parser.parse_args()
+    parser.add_argument("--curriculum", choices=tuple(CURRICULA), default="replay")
+    parser.add_argument("--commission", choices=tuple(COMMISSION), default="jointwise")
+    parser.add_argument(
+        "--twin",
+        type=Path,
+        default=None,
+        help="a twin file of the UR10e (default: identified into twin/)",
+    )
+    parser.add_argument(
+        "--name",
+        default=None,
+        help="this run's directory under outputs/real_arms/ (default: curriculum)",
+    )
+    parser.add_argument(
+        "--swap",
+        default=None,
+        metavar="VARIANT",
+        help="print instead where the real arm's healthy running looks faulty "
+        "to VARIANT of this run, and why (the channel-swap table)",
+    )
+    args = parser.parse_args()  # fmt: skip
+    name = args.name or args.curriculum
+    if args.swap:
+        swap_table(name, args.swap)
+        return
     if not LOGS.is_dir():
         raise SystemExit(f"no logs in {LOGS}: run experiments/real_arms/fetch.sh")
-    twin = ROOT / "twin" / "twin.yaml"
+    twin = args.twin or ROOT / "twin" / "twin.yaml"
     if not twin.is_file():
         run("robohealth_mj.identify", "arm=ur10e", f"fit={as_list(LOGS_ROLES['fit'])}",
             f"validate={as_list(LOGS_ROLES['validate'])}", f"out={twin.parent}")  # fmt: skip
-    if not (CORPUS / "corpus.json").is_file():
-        run("robohealth_mj.corpus", f"corpus={args.corpus}", f"out_dir={CORPUS}",
-            f'record_overrides=["arm=ur10e","sim.twin={twin}"]', "progress=false")  # fmt: skip
-    sweep = ROOT / "models"
+    tag = f"_{args.twin.stem}" if args.twin else ""
+    corpora = [record_corpus(c, twin, tag) for c in CURRICULA[args.curriculum]]
+    train = ",".join(f"{c}/train_*" for c in corpora)
+    sweep = ROOT / name / "models"
     if not any(sweep.rglob("best.ckpt")):
         run("robohealth_mj.train", "-m", f"variant={args.variants}", f"seed={args.seed}",
-            "sensing=stock_reduced", "window=32", f"data.train=[{CORPUS}/train_*]",
-            f"data.evaluate.heldout={CORPUS}/heldout_seed900", "data.evaluate.probe=null",
+            "sensing=stock_reduced", "window=32", f"data.train=[{train}]",
+            f"data.evaluate.heldout={corpora[-1]}/heldout_seed900", "data.evaluate.probe=null",
             f"trainer.epochs={args.epochs}", "trainer.threads=1", "trainer.progress=false",
             "hydra/launcher=local", f"hydra.sweep.dir={sweep}")  # fmt: skip
-    verdicts = ROOT / "verdicts"
+    commissioning = [p for role in COMMISSION[args.commission] for p in LOGS_ROLES[role]]
+    verdicts = ROOT / name / "verdicts"
     for ckpt in sorted(p for p in sweep.rglob("best.ckpt") if p.parent.name != "commissioned"):
         variant = next(part for part in ckpt.parts if part in args.variants.split(","))
         done = ckpt.parent / "commissioned"
         if not (done / "best.ckpt").is_file():
             run("robohealth_mj.commission", f"model={ckpt}", "arm=ur10e",
-                f"healthy={as_list(LOGS_ROLES['commission'])}", f"out={done}")  # fmt: skip
+                f"healthy={as_list(commissioning)}", f"out={done}")  # fmt: skip
         targets = [("healthy", p) for p in healthy_monitored()]
         targets += [(kind, p) for kind, paths in events().items() for p in paths]
         for kind, log in targets:

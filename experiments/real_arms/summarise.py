@@ -13,13 +13,20 @@ from pathlib import Path
 
 from robohealth_mj.logs.convert import convert_log
 
-VERDICTS = Path("outputs/real_arms/verdicts")
+MOTIONS = {"ptp": "point-to-point", "ur-20_01_17-p": "holding a pose"}  # by the logs' names
+
+
+def kind_of(log: str) -> str:
+    return next((v for k, v in MOTIONS.items() if k in log), "excitation / free motion")
+
+
+ROOT = Path("outputs/real_arms")
 TICK_HZ = 20.0
 
 
-def _rows(variant: str, kind: str) -> list[dict]:
+def _rows(verdicts: Path, variant: str, kind: str) -> list[dict]:
     out = []
-    for path in sorted((VERDICTS / variant / kind).glob("*.json")):
+    for path in sorted((verdicts / variant / kind).glob("*.json")):
         d = json.loads(path.read_text())
         if "metrics" in d:  # evaluate: windows, all labelled healthy
             m = d["metrics"]
@@ -34,37 +41,48 @@ def _rows(variant: str, kind: str) -> list[dict]:
     return out
 
 
+def _line(run: str, v: str, what: str, rows: list[dict]) -> str:
+    secs = sum(r["seconds"] for r in rows)
+    n = sum(r["n"] for r in rows)
+    faulty = sum(r["faulty"] * r["n"] for r in rows) / max(n, 1)
+    alarms = None if rows[0]["alarms"] is None else sum(r["alarms"] for r in rows)
+    rate = "n/a (no streaming form)" if alarms is None else f"{alarms / (secs / 3600):.0f}"
+    name = f"**{v}**" if v == "gbdt" else v
+    return (f"| {run} | {name} | {what} | {len(rows)} | {secs / 60:.1f} | "
+            f"{alarms if alarms is not None else 'n/a'} | {rate} | {faulty:.3f} |")  # fmt: skip
+
+
 def main() -> None:
-    variants = sorted(p.name for p in VERDICTS.iterdir() if p.is_dir())
+    runs = [(p.parent.name, p) for p in sorted(ROOT.glob("*/verdicts"))]  # campaign.py --name
     print("## Healthy real running (after commissioning on the joint-wise logs, 6.8 min)\n")
-    print("| model | logs | healthy minutes | alarms | alarms / h | share called faulty |")
-    print("|---|---|---|---|---|---|")
-    for v in variants:
-        rows = _rows(v, "healthy")
-        if not rows:
-            continue
-        secs = sum(r["seconds"] for r in rows)
-        n = sum(r["n"] for r in rows)
-        faulty = sum(r["faulty"] * r["n"] for r in rows) / max(n, 1)
-        alarms = None if rows[0]["alarms"] is None else sum(r["alarms"] for r in rows)
-        rate = "n/a (no streaming form)" if alarms is None else f"{alarms / (secs / 3600):.0f}"
-        print(
-            f"| **{v}** | {len(rows)} | {secs / 60:.1f} | {alarms if alarms is not None else 'n/a'}"
-            f" | {rate} | {faulty:.3f} |"
-        )
+    print("Monitored: the healthy logs without payload that neither commission nor are replayed "
+          "(`healthy_monitored` in campaign.py).\n")  # fmt: skip
+    print("| run | model | logs | n | healthy minutes | alarms | alarms / h "
+          "| share called faulty |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
+    for run, verdicts in runs:
+        for v in sorted(p.name for p in verdicts.iterdir() if p.is_dir()):
+            rows = _rows(verdicts, v, "healthy")
+            if not rows:
+                continue
+            print(_line(run, v, "all", rows))
+            for kind in sorted({kind_of(r["log"]) for r in rows}):
+                print(_line(run, v, kind, [r for r in rows if kind_of(r["log"]) == kind]))
     for kind, title in (
         ("push", "Pushed while holding a pose"),
         ("load", "Runs with an added load"),
     ):
         print(f"\n## {title}\n")
-        print("| model | log | seconds | alarms | share called faulty |")
-        print("|---|---|---|---|---|")
-        for v in variants:
-            for r in _rows(v, kind):
-                alarms = "n/a" if r["alarms"] is None else r["alarms"]
-                print(f"| {v} | {r['log']} | {r['seconds']:.1f} | {alarms} | {r['faulty']:.3f} |")
+        print("| run | model | log | seconds | alarms | share called faulty |")
+        print("|---|---|---|---|---|---|")
+        for run, verdicts in runs:
+            for v in sorted(p.name for p in verdicts.iterdir() if p.is_dir()):
+                for r in _rows(verdicts, v, kind):
+                    alarms = "n/a" if r["alarms"] is None else r["alarms"]
+                    print(f"| {run} | {v} | {r['log']} | {r['seconds']:.1f} | {alarms} | "
+                          f"{r['faulty']:.3f} |")  # fmt: skip
     print(
-        "\nPer log: `outputs/real_arms/verdicts/<model>/<kind>/<log>.json`; "
+        "\nPer log: `outputs/real_arms/<run>/verdicts/<model>/<kind>/<log>.json`; "
         "command: `bash results/real_arms/command.sh`."
     )
 

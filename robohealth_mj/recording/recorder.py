@@ -38,6 +38,7 @@ from robohealth_mj.schema import (
     FaultLabel,
 )
 from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
+from robohealth_mj.sim.twin_file import read_twin_noise
 
 GRAPHS_FILE = "graphs.jsonl"
 MANIFEST_FILE = "manifest.json"
@@ -162,6 +163,9 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
     sensors = instantiate(cfg.sensors, physics_rate_hz=1.0 / model.opt.timestep, _convert_="all")
     # the drive's torque sensing resolves the same fraction of its rating on every arm
     sensors.effort_scale = description.rated_torque / np.asarray(cfg.sim.reference_torque_nm)
+    noise = read_twin_noise(cfg.sim.twin, description.name) if cfg.sim.get("twin") else None
+    if noise is not None:  # a twin reads its effort as noisily as the real arm's current does
+        sensors.effort_scale = noise / sensors.noise.effort
     variation.apply_to_sensors(sensors, arm)
     tick_s = round(1.0 / (cfg.session.tick_hz * model.opt.timestep)) * model.opt.timestep
     schedule = instantiate(cfg.faults.schedule, tick_s=tick_s, seed=cfg.seed, _convert_="all")

@@ -95,9 +95,13 @@ class DriveModel:
 
 
 def build_arm_scene(
-    arm: ArmDescription, drives: Mapping[str, Mapping[str, float]], scene: Path
+    arm: ArmDescription,
+    drives: Mapping[str, Mapping[str, float]],
+    scene: Path,
+    mount_height_m: float = 0.0,
 ) -> mjcf.RootElement:
-    """The scene (``scene``: floor, lights, cameras) with ``arm`` standing at the origin."""
+    """The scene (``scene``: floor, lights, cameras) with ``arm`` standing at the origin,
+    ``mount_height_m`` above the floor (on a pedestal, so its links can reach below the base)."""
     root = mjcf.from_path(str(scene))
     root.model = arm.name
     root.compiler.angle = "radian"
@@ -108,7 +112,10 @@ def build_arm_scene(
     root.statistic.extent = float(root.statistic.extent) * size
 
     base = root.worldbody.add(
-        "body", name="base", quat=_qmul(quat_rpy([0, 0, BASE_YAW]), quat_rpy([0, 0, np.pi]))
+        "body",
+        name="base",
+        pos=[0.0, 0.0, float(mount_height_m)],
+        quat=_qmul(quat_rpy([0, 0, BASE_YAW]), quat_rpy([0, 0, np.pi])),
     )
     r, h, m = arm.base_radius, arm.base_length, arm.base_mass  # UR's cylinder inertial
     ixx = m * (3 * r * r + h * h) / 12.0

@@ -43,6 +43,7 @@ def build_model(
     drive_overrides: dict | None = None,
     scene: Path | str = SCENE_XML,
     twin: Path | str | None = None,
+    mount_height_m: float = 0.0,
 ) -> mujoco.MjModel:
     """Compile arm ``arm`` in the scene at physics time step ``timestep``.
 
@@ -51,13 +52,16 @@ def build_model(
     ``frictionloss`` (motor side) and ``stiffness``, ``tendon_damping``, ``backlash`` (the drive
     tendon), set after scaling to the arm. ``twin``: an identified twin file of this arm
     (``python -m robohealth_mj.identify``) whose drive parameters replace the scaled ones (before
-    ``drive_overrides``).
+    ``drive_overrides``). ``mount_height_m``: the base stands this high above the floor (a
+    real arm on a table or pedestal, whose program reaches below its base plane).
     """
     scene = Path(scene)
     if not scene.is_file():
         raise FileNotFoundError(f"scene file not found: {scene} (set ROBOHEALTH_ASSETS?)")
     if not float(timestep) > 0:
         raise InputError(f"sim.timestep: must be > 0, got {timestep}")
+    if not 0.0 <= float(mount_height_m) <= 10.0:
+        raise InputError(f"sim.mount_height_m: in [0, 10] m, got {mount_height_m}")
     model = (
         default_drives()
         if drives is None
@@ -79,7 +83,7 @@ def build_model(
         if unknown:
             raise KeyError(f"unknown drive parameters for {joint}: {unknown}")
         per_joint[joint].update({k: float(v) for k, v in params.items()})
-    root = build_arm_scene(description, per_joint, scene)
+    root = build_arm_scene(description, per_joint, scene, float(mount_height_m))
     root.option.timestep = float(timestep)
     return mujoco.MjModel.from_xml_string(root.to_xml_string(), assets=root.get_assets())
 

@@ -2,14 +2,16 @@
 
 YAML with the arm it is of, per joint the drive parameters that replace the simulator's
 (``drive_overrides``: rotor inertia, viscous and Coulomb friction), the torque constants, the
-logs it was fitted on and the fit's residuals. ``sim.twin=FILE`` (with ``arm=`` the same arm)
-makes every simulation run on it.
+measured torque's noise per tick (``effort_noise_nm``, what the simulated effort reads with; null
+keeps the sensor package's), the logs it was fitted on and the fit's residuals.
+``sim.twin=FILE`` (with ``arm=`` the same arm) makes every simulation run on it.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from robohealth_mj.common.atomic import atomic_write_text
@@ -23,9 +25,7 @@ def write_twin(path: Path, content: dict) -> None:
     atomic_write_text(path, yaml.safe_dump(content, sort_keys=False))
 
 
-def read_twin(path: Path | str, arm: str) -> dict[str, dict[str, float]]:
-    """The drive overrides of twin file ``path``, which must be of ``arm``; one line otherwise."""
-    path = Path(path)
+def _load(path: Path, arm: str) -> dict:
     try:
         raw = yaml.safe_load(path.read_text())
     except OSError as exc:
@@ -37,7 +37,27 @@ def read_twin(path: Path | str, arm: str) -> dict[str, dict[str, float]]:
     if raw.get("arm") != arm:
         raise InputError(f"{path}: key 'arm': the twin is of {raw.get('arm')!r} and the "
                          f"simulation's arm is {arm!r}: pass arm={raw.get('arm')}")  # fmt: skip
-    overrides = raw["drive_overrides"]
+    return raw
+
+
+def read_twin_noise(path: Path | str, arm: str) -> np.ndarray | None:
+    """The measured torque's noise per tick ``[6]`` (N*m) of twin file ``path``; None where it
+    states none (a twin identified from logs without a hold)."""
+    path = Path(path)
+    noise = _load(path, arm).get("effort_noise_nm")
+    if noise is None:
+        return None
+    if (not isinstance(noise, list) or len(noise) != len(JOINT_NAMES)
+            or not all(isinstance(v, (int, float)) and v >= 0 for v in noise)):  # fmt: skip
+        raise InputError(f"{path}: key 'effort_noise_nm': {len(JOINT_NAMES)} numbers >= 0 or "
+                         f"null, got {noise!r}")  # fmt: skip
+    return np.asarray(noise, dtype=float)
+
+
+def read_twin(path: Path | str, arm: str) -> dict[str, dict[str, float]]:
+    """The drive overrides of twin file ``path``, which must be of ``arm``; one line otherwise."""
+    path = Path(path)
+    overrides = _load(path, arm)["drive_overrides"]
     out = {}
     for joint in JOINT_NAMES:
         params = (overrides or {}).get(joint)

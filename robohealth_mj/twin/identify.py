@@ -33,6 +33,9 @@ from robohealth_mj.twin.joint_log import JointLog
 
 SIGN_VELOCITY = 0.02  # rad/s: sign(qd) as tanh(qd / this), so friction is smooth through rest
 CUTOFF_HZ = 10.0  # the velocity's low-pass before differentiation (zero phase)
+STILL_RAD_S = 1e-3  # every joint slower than this: the arm holds still
+STILL_S = 1.0  # the shortest hold the measurement noise is read from
+TICK_HZ = 20.0  # the recordings' tick rate: the noise is what one tick reads
 
 
 @dataclass
@@ -118,6 +121,25 @@ class Identified:
     seconds: float
     used_model_torque: bool
     notes: list[str] = field(default_factory=list)
+    effort_noise: np.ndarray | None = None  # N*m per tick, per joint; None: no hold to read it
+
+
+def effort_noise(logs: Sequence[JointLog], k_t: np.ndarray) -> np.ndarray | None:
+    """Per joint, the measured torque's noise as one 20 Hz tick reads it (N*m): while the arm
+    holds still for a second or more, the spread of tick-to-tick differences of current x k_t
+    over sqrt(2), which a hold's own offset (where static friction left the joint) does not
+    enter. Our simulator's default is a torque sensor's; a real drive's current is noisier."""
+    steps = []
+    for log in logs:
+        still = np.abs(log.qd).max(axis=1) < STILL_RAD_S
+        stride = max(1, round(log.rate_hz / TICK_HZ))
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], still.astype(int), [0]])))
+        for start, end in zip(edges[::2], edges[1::2], strict=True):
+            if log.t[end - 1] - log.t[start] >= STILL_S:
+                steps.append(np.diff(log.current[start:end:stride] * k_t, axis=0))
+    if not steps or sum(len(s) for s in steps) < 20:
+        return None
+    return np.concatenate(steps).std(axis=0) / np.sqrt(2.0)
 
 
 def identify(arm: str, logs: Sequence[JointLog]) -> Identified:
@@ -154,9 +176,13 @@ def identify(arm: str, logs: Sequence[JointLog]) -> Identified:
         damping[j], friction[j] = coef[1] * k_t[j], coef[2] * k_t[j]
     if not with_model:
         notes.append("no model torque in the logs: rotor inertia fitted on the current")
+    noise = effort_noise(logs, k_t)
+    if noise is None:
+        notes.append("no hold of 1 s or more in the logs: the simulator's effort noise is kept")
     rows = len(current)
     seconds = float(sum(log.t[-1] - log.t[0] for log in logs))
-    return Identified(Drives(armature, damping, friction, k_t), rows, seconds, with_model, notes)
+    return Identified(Drives(armature, damping, friction, k_t), rows, seconds, with_model, notes,
+                      noise)  # fmt: skip
 
 
 def nrmse(simulated: np.ndarray, measured: np.ndarray) -> np.ndarray:

@@ -27,6 +27,9 @@ def run_identification(
         "arm": arm,
         "drive_overrides": drives.overrides(),
         "torque_constant_nm_per_a": [round(float(v), 4) for v in drives.torque_constant],
+        # the measured torque's noise per 20 Hz tick (holds in the fit logs): what the simulated
+        # effort reads with instead of the torque sensor's default
+        "effort_noise_nm": None if found.effort_noise is None else _list(found.effort_noise),
         "fit": {
             "logs": [Path(p).name for p in fit],
             "rows": found.rows,

@@ -298,3 +298,23 @@ def test_a_headerless_log_reads_through_the_map_that_names_its_columns(tmp_path,
     log.write_text("\n".join(lines) + "\n")
     assert ingest_main([str(log), "--out", str(tmp_path / "bad")]) == 2
     assert "line 8: column 'actual_q_0': 'x" in capsys.readouterr().err
+
+
+def test_the_short_headerless_layout_reads_without_the_targets(tmp_path, capsys):
+    """The same logs' earlier layout: 19 numbers a row (time, positions, velocities, currents),
+    read with the joint_states profile, and ingest says what it dropped and why."""
+    t = np.arange(0, 3.0, 1 / 100.0)
+    cols = _rtde(t)
+    order = ["timestamp"] + [f"{c}_{j}" for c in ("actual_q", "actual_qd", "actual_current")
+                             for j in range(J)]  # fmt: skip
+    log = tmp_path / "ur-19_09_27-11_28_22.csv"
+    log.write_text("\n".join(",".join(f"{cols[n][i]:.9g}" for n in order)
+                             for i in range(len(t))) + "\n")  # fmt: skip
+    cmap, (session,) = convert_log(log)
+    assert cmap.name == "ur_rtde_headerless_short" and session.stats["sensing"] == "joint_states"
+    np.testing.assert_allclose(session.state[:, 2, 2], cols["actual_current_2"][::5] * 9.65,
+                               rtol=1e-6)  # fmt: skip
+    assert ingest_main([str(log), "--out", str(tmp_path / "out")]) == 0
+    said = capsys.readouterr().out
+    assert "sensing profile joint_states" in said
+    assert "effort_residual dropped (column 'target_current_0' missing)" in said

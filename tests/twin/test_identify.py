@@ -133,3 +133,21 @@ def test_a_twin_of_another_arm_or_a_bad_value_is_one_line(tmp_path, twin):
     (tmp_path / "bad.yaml").write_text(yaml.safe_dump(bad))
     with pytest.raises(InputError, match=r"drive_overrides\.elbow\.damping': a number >= 0"):
         build_model("ur10e", twin=tmp_path / "bad.yaml")
+
+
+def test_the_effort_noise_is_read_from_the_holds_not_their_offsets():
+    """A real drive's current is noisier than our torque sensor: identification reads the noise
+    one 20 Hz tick sees from the logs' holds (a second or more), whatever offset each hold has."""
+    from robohealth_mj.twin.identify import effort_noise
+    from robohealth_mj.twin.joint_log import JointLog
+
+    rng = np.random.default_rng(0)
+    t = np.arange(0.0, 30.0, 0.01)
+    qd = np.where(((t % 10.0) < 4.0)[:, None], 0.3, 0.0) * np.ones((1, 6))  # 4 s move, 6 s hold
+    sigma = np.array([0.7, 0.55, 0.25, 0.13, 0.15, 0.2])
+    offset = np.floor(t / 10.0)[:, None] * np.array([3.0, -2.0, 1.0, 0.5, -0.5, 0.2])
+    torque = offset + rng.normal(0.0, 1.0, (len(t), 6)) * sigma
+    log = JointLog("holds", t, np.zeros((len(t), 6)), qd, torque / K_T, None)
+    np.testing.assert_allclose(effort_noise([log], K_T), sigma, rtol=0.15)
+    moving = JointLog("moving", t, np.zeros((len(t), 6)), qd + 0.3, torque / K_T, None)
+    assert effort_noise([moving], K_T) is None  # no hold: the simulator's noise is kept
