@@ -35,7 +35,8 @@ def main(argv: list[str] | None = None) -> None:
                             placement_fit=cfg.placement_fit,
                             placement_prune=cfg.get("placement_prune"),
                             operating_point=cfg.operating_point,
-                            arm=cfg.get("arm"))  # fmt: skip
+                            arm=cfg.get("arm"),
+                            healthy_rate=cfg.get("healthy_rate"))  # fmt: skip
         atomic_write_json(out / "commissioning.json", record)
     print(f"{record['healthy_minutes']:g} healthy minutes -> {record['checkpoint']}")
     for row in record["settling"]:
@@ -65,6 +66,12 @@ def main(argv: list[str] | None = None) -> None:
             f"healthy {point['arm_healthy_rate_before']:.3f} -> "
             f"{point['arm_healthy_rate_after']:.3f} (validation: "
             f"{point['validation_healthy_rate']:.3f})"
+        )
+    if "healthy_rate_asked" in point:
+        print(
+            f"asked for {point['healthy_rate_asked']:g} healthy: validation's faulted windows "
+            f"called a fault {point['validation_fault_recall_before']:.3f} -> "
+            f"{point['validation_fault_recall_after']:.3f}"
         )
     if "onnx" in record:
         print(f"exported -> {record['onnx']}")

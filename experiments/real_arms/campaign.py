@@ -4,13 +4,14 @@ real logs and monitor the arm's other real logs.
 
     experiments/real_arms/fetch.sh                   # the logs -> outputs/real_arms/logs/
     python experiments/real_arms/campaign.py [--curriculum standard|replay|mixed]
-        [--commission jointwise|jointwise+program] [--twin FILE] [--name RUN]
+        [--commission jointwise|jointwise+program] [--healthy-rate R] [--twin FILE] [--name RUN]
         [--variants gbdt,stgnn_fixed] [--seed 42] [--epochs 10]
 
 ``--curriculum standard`` trains on our sweeps and payloads (the quick corpus on the twin);
 ``replay`` on the arm's own program: the ``program`` logs replayed on the twin with no payload
-(``conf/corpus/replay.yaml``, ``curriculum=replay``); ``mixed`` on both corpora. ``--commission``
-names the healthy real running the models are commissioned on. Writes under
+(``conf/corpus/replay.yaml``, ``curriculum=replay``); ``mixed`` on both corpora; ``programs`` on
+the standard sweeps and pendant-taught point-to-point programs (``pick_place`` family).
+``--commission`` names the healthy real running the models are commissioned on. Writes under
 ``outputs/real_arms/``: ``twin/`` (twin.yaml, fidelity.md), the corpora
 ``outputs/corpus/real_ur10e_<curriculum>``, and per run (``--name``, default the curriculum) the
 models ``<run>/models/`` and per model and log the monitor's verdict (``<run>/verdicts/``). Every
@@ -86,7 +87,8 @@ LOGS_ROLES = {
 
 
 # the corpora each curriculum trains on (the last one's held-out session is the one evaluated)
-CURRICULA = {"standard": ["standard"], "replay": ["replay"], "mixed": ["standard", "replay"]}
+CURRICULA = {"standard": ["standard"], "replay": ["replay"], "mixed": ["standard", "replay"],
+             "programs": ["programs"]}  # fmt: skip
 # the healthy real running each model is commissioned on
 COMMISSION = {"jointwise": ["commission"], "jointwise+program": ["commission", "program"]}
 
@@ -124,14 +126,25 @@ def as_list(paths: list[Path]) -> str:
     return "[" + ",".join(str(p) for p in paths) + "]"
 
 
-def record_corpus(curriculum: str, twin: Path, tag: str) -> Path:
-    """The quick-size corpus of ``curriculum`` on ``twin`` (recorded once)."""
-    corpus = Path(f"outputs/corpus/real_ur10e_{curriculum}{tag}")
-    overrides = ["arm=ur10e", f"sim.twin={twin}", f"sim.mount_height_m={MOUNT_M}"]
-    if curriculum == "replay":
-        overrides += ["curriculum=replay", f"curriculum.files={as_list(LOGS_ROLES['program'])}"]
+# each corpus: its config and what its sessions add to the twin's record overrides
+CORPORA = {
+    "standard": ("quick", []),
+    "replay": (
+        "replay",
+        ["curriculum=replay", f"curriculum.files={as_list(LOGS_ROLES['program'])}"],
+    ),
+    # the standard sweeps and the pendant-taught point-to-point programs (pick and place,
+    # palletising: moves between poses with dwells)
+    "programs": ("quick", ["curriculum.families=[single_joint,joint_pair,whole_arm,pick_place]"]),
+}
+
+
+def record_corpus(corpus_name: str, twin: Path, tag: str) -> Path:
+    """The quick-size corpus ``corpus_name`` (CORPORA) on ``twin`` (recorded once)."""
+    corpus = Path(f"outputs/corpus/real_ur10e_{corpus_name}{tag}")
+    config, extra = CORPORA[corpus_name]
+    overrides = ["arm=ur10e", f"sim.twin={twin}", f"sim.mount_height_m={MOUNT_M}", *extra]
     if not (corpus / "corpus.json").is_file():
-        config = "replay" if curriculum == "replay" else "quick"
         run("robohealth_mj.corpus", f"corpus={config}", f"out_dir={corpus}",
             f"record_overrides={json.dumps(overrides)}", "progress=false")  # fmt: skip
     return corpus
@@ -168,10 +181,10 @@ def share(model: Path, xs: list[np.ndarray], like: list[schema.GraphSample]) -> 
     return faulty / max(decided, 1)
 
 
-def swap_table(run_name: str, variant: str) -> None:
+def swap_table(run_name: str, variant: str, suffix: str) -> None:
     """Prints the channel-swap table (see ``--swap``) for ``variant`` of run ``run_name``."""
     models = ROOT / run_name / "models"
-    model = next(p for p in models.rglob("commissioned/model.onnx") if variant in p.parts)
+    model = next(p for p in models.rglob(f"commissioned{suffix}/model.onnx") if variant in p.parts)
     twin = ROOT / "twin" / "twin.yaml"
     residual = schema.feature_index("effort_residual")
     short = ("pan", "lift", "elbow", "w1", "w2", "w3")
@@ -225,6 +238,12 @@ def main() -> None:
         help="this run's directory under outputs/real_arms/ (default: curriculum)",
     )
     parser.add_argument(
+        "--healthy-rate",
+        type=float,
+        default=None,
+        help="commission at this healthy rate (commission healthy_rate=)",
+    )
+    parser.add_argument(
         "--swap",
         default=None,
         metavar="VARIANT",
@@ -233,8 +252,12 @@ def main() -> None:
     )
     args = parser.parse_args()  # fmt: skip
     name = args.name or args.curriculum
+    # beside the jointwise ones at validation's healthy rate
+    suffix = ("" if args.commission == "jointwise" else "_program") + (
+        f"_rate{args.healthy_rate:g}" if args.healthy_rate else ""
+    )
     if args.swap:
-        swap_table(name, args.swap)
+        swap_table(name, args.swap, suffix)
         return
     if not LOGS.is_dir():
         raise SystemExit(f"no logs in {LOGS}: run experiments/real_arms/fetch.sh")
@@ -253,14 +276,18 @@ def main() -> None:
             f"trainer.epochs={args.epochs}", "trainer.threads=1", "trainer.progress=false",
             "hydra/launcher=local", f"hydra.sweep.dir={sweep}")  # fmt: skip
     commissioning = [p for role in COMMISSION[args.commission] for p in LOGS_ROLES[role]]
-    verdicts = ROOT / name / "verdicts"
-    for ckpt in sorted(p for p in sweep.rglob("best.ckpt") if p.parent.name != "commissioned"):
+    verdicts = ROOT / name / f"verdicts{suffix}"
+    for ckpt in sorted(p for p in sweep.rglob("best.ckpt") if "commissioned" not in p.parent.name):
         variant = next(part for part in ckpt.parts if part in args.variants.split(","))
-        done = ckpt.parent / "commissioned"
+        done = ckpt.parent / f"commissioned{suffix}"
         if not (done / "best.ckpt").is_file():
             run("robohealth_mj.commission", f"model={ckpt}", "arm=ur10e",
-                f"healthy={as_list(commissioning)}", f"out={done}")  # fmt: skip
-        targets = [("healthy", p) for p in healthy_monitored()]
+                f"healthy={as_list(commissioning)}", f"out={done}",
+                f"healthy_rate={args.healthy_rate or 'null'}")  # fmt: skip
+        # the program logs: healthy real running no run is judged on, so runs are compared on
+        # it (selection); in-sample for the curricula that replay it
+        targets = [("program", p) for p in LOGS_ROLES["program"]]
+        targets += [("healthy", p) for p in healthy_monitored()]
         targets += [(kind, p) for kind, paths in events().items() for p in paths]
         for kind, log in targets:
             out = verdicts / variant / kind / f"{log.stem}.json"

@@ -1,16 +1,31 @@
 #!/usr/bin/env bash
-# Issue 37's real-arm figures as run on 2026-11-25, from the repository root (about 25 minutes on
-# 2 cores): fetch the public UR10e logs, identify the twin (results/real_arms/twin.yaml,
-# fidelity.md), record the quick corpus on it, train gbdt and stgnn_fixed for the stock_reduced
-# profile (seed 42, W = 32, 10 epochs), commission on the joint-wise logs, monitor the rest.
+# Issue 37's real-arm figures as run on 2026-11-25, from the repository root (about 80 minutes on
+# 2 cores): fetch the public UR10e logs, ingest each, identify the twin (twin.yaml, fidelity.md),
+# then per training curriculum record a quick-size corpus on the twin, train gbdt and stgnn_fixed
+# for the stock_reduced profile (seed 42, W = 32, 10 epochs), commission on the joint-wise logs
+# (at validation's healthy rate, and at 0.99), monitor the program logs (selection) and the other
+# healthy logs, the pushes and the added loads; then the tables.
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
+CAMPAIGN="$PY experiments/real_arms/campaign.py --variants gbdt,stgnn_fixed --seed 42 --epochs 10"
 [ -d outputs/real_arms/logs ] || experiments/real_arms/fetch.sh
 for f in outputs/real_arms/logs/*/*.csv; do   # which logs ingest, with which profile
   if out=$($PY -m robohealth_mj.ingest "$f" --out "outputs/real_arms/ingested/$(basename "$f" .csv)" 2>&1); then
     echo "0 $(basename "$f"): $(echo "$out" | grep 'sensing profile')"
   else echo "2 $(basename "$f"): $out"; fi
 done > results/real_arms/ingest.txt
-$PY experiments/real_arms/campaign.py --variants gbdt,stgnn_fixed --seed 42 --epochs 10
-cp outputs/real_arms/twin/twin.yaml results/real_arms/twin.yaml
+$CAMPAIGN --curriculum standard                      # our sweeps and payloads (identifies the twin)
+$CAMPAIGN --curriculum standard --healthy-rate 0.99  # the same models, a quieter operating point
+$CAMPAIGN --curriculum replay                        # the arm's own program replayed on the twin
+$CAMPAIGN --curriculum mixed                         # both corpora
+$CAMPAIGN --curriculum programs                      # sweeps and pendant-taught point-to-point
+$CAMPAIGN --curriculum programs --healthy-rate 0.99
+# the twin without its identified effort noise (the ablation of effort_noise_nm)
+$PY -c "import yaml; t = yaml.safe_load(open('outputs/real_arms/twin/twin.yaml')); t['effort_noise_nm'] = None; yaml.safe_dump(t, open('outputs/real_arms/twin_without_noise.yaml', 'w'), sort_keys=False)"
+$CAMPAIGN --curriculum replay --twin outputs/real_arms/twin_without_noise.yaml --name replay_twin_without_noise
+cp outputs/real_arms/twin/twin.yaml results/real_arms/  # fidelity.md: the rows of outputs/real_arms/twin/fidelity.md
 $PY experiments/real_arms/summarise.py > results/real_arms/sim_to_real.md
+$PY experiments/real_arms/campaign.py --curriculum standard --swap stgnn_fixed > results/real_arms/swap_channels.md
+$PY experiments/real_arms/campaign.py --curriculum replay --swap stgnn_fixed >> results/real_arms/swap_channels.md
+{ $PY experiments/real_arms/events.py --run standard; echo;
+  $PY experiments/real_arms/events.py --run standard --suffix _rate0.99; } > results/real_arms/events.md

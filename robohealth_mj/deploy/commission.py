@@ -104,13 +104,14 @@ def commission(
     placement_prune: float | None = None,
     operating_point: str = "per_class",
     arm: str | None = None,
+    healthy_rate: float | None = None,
 ) -> dict[str, Any]:
     """Write ``out_dir/best.ckpt`` (and ``model.onnx`` for a network) commissioned on
     ``healthy``; the commissioning record (also in the checkpoint). A harness model with a
     coupling head also has its ``C`` refitted to the arm's ``placement``
     (:mod:`robohealth_mj.deploy.recouple`). ``arm``: the arm ``healthy`` comes from where it
     names none (a controller log, a bag)."""
-    check_recipe(operating_point)  # before minutes of work, not after
+    check_recipe(operating_point, healthy_rate)  # before minutes of work, not after
     ckpt = load_checkpoint(ckpt_path)
     healthy_files = expand_paths(healthy)
     arm_name = single_arm(healthy_files, arm, "healthy")
@@ -179,6 +180,7 @@ def commission(
         list((ckpt.get("split_runs") or {}).get("val", [])),
         Reading(arm, graph, mean, std),
         operating_point,
+        healthy_rate,
     )
     save_checkpoint(
         out_dir / CHECKPOINT,

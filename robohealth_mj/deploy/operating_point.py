@@ -16,6 +16,12 @@ are as the model had them. Two recipes (``operating_point=``):
 
 Chosen on a labelled validation session of an unseen program (``val_unseen_program``), see
 ``docs/stock_arm.md``.
+
+Matching validation's rate keeps the false calls validation has (a few per cent of healthy
+windows). A user who wants a quieter monitor names the healthy rate instead (``healthy_rate``,
+e.g. 0.99): the per-class recipe then allows each fault class its share of ``1 - healthy_rate``
+at most, and the record says what it costs: the share of validation's faulted windows still
+called a fault, before and after.
 """
 
 from __future__ import annotations
@@ -54,14 +60,19 @@ def class_rates(logits: np.ndarray, classes: int) -> np.ndarray:
     return np.bincount(logits.argmax(1), minlength=classes) / max(len(logits), 1)
 
 
-def per_class_offset(validation: np.ndarray, arm: np.ndarray) -> np.ndarray:
+def per_class_offset(
+    validation: np.ndarray, arm: np.ndarray, healthy_rate: float | None = None
+) -> np.ndarray:
     """Offsets ``[C]`` (``<= 0``, none on healthy) that lower each fault class's logit until
     the arm's healthy windows (``arm [K, C]`` logits) are called it no more often than the
-    validation session's healthy windows (``validation``) are."""
+    validation session's healthy windows (``validation``) are, and, with ``healthy_rate``, no
+    more often than an equal share of ``1 - healthy_rate``."""
     classes = arm.shape[1]
     # a rate below one validation window is not measured: it would let one outlier of the
     # arm's windows set a class's whole offset
     allowed = np.maximum(class_rates(validation, classes), 1.0 / len(validation))
+    if healthy_rate is not None:
+        allowed = np.minimum(allowed, (1.0 - healthy_rate) / (classes - 1))
     offset = np.zeros(classes)
     for _ in range(ROUNDS):
         moved = False
@@ -91,18 +102,28 @@ def healthy_offset(validation: np.ndarray, arm: np.ndarray) -> np.ndarray:
     return offset
 
 
-def check_recipe(recipe: str) -> None:
+def check_recipe(recipe: str, healthy_rate: float | None = None) -> None:
     if recipe not in RECIPES:
         raise InputError(f"operating_point must be one of {RECIPES}, got {recipe!r}")
+    if healthy_rate is not None and not (
+        recipe == "per_class" and isinstance(healthy_rate, (int, float)) and 0 < healthy_rate < 1
+    ):
+        raise InputError(f"healthy_rate: a number in (0, 1) with operating_point=per_class, "
+                         f"got {healthy_rate!r} with {recipe}")  # fmt: skip
 
 
 def healthy_logits(
-    model: torch.nn.Module, reading: Reading, window: int, runs: list[str] | None = None
+    model: torch.nn.Module,
+    reading: Reading,
+    window: int,
+    runs: list[str] | None = None,
+    faulted: bool = False,
 ) -> np.ndarray:
-    """The class logits ``[K, C]`` of the healthy windows (of ``runs`` only, where given)."""
+    """The class logits ``[K, C]`` of the healthy windows (``faulted``: of the faulted ones)
+    (of ``runs`` only, where given)."""
     rec = reading.graph.relabel(reading.rec)
     windows = make_windows(rec, window)
-    keep = ~rec.active[windows.end]
+    keep = rec.active[windows.end] == faulted
     if runs is not None:
         keep &= np.isin(np.asarray(rec.run_ids)[rec.run[windows.end]], runs)
     windows = windows.subset(keep)
@@ -120,12 +141,14 @@ def match_operating_point(
     validation_runs: list[str],
     arm: Reading,
     recipe: str = "per_class",
+    healthy_rate: float | None = None,
 ) -> tuple[np.ndarray, dict[str, Any]]:
     """The class offset ``[C]`` that has ``arm``'s healthy windows called healthy (``recipe``
     ``healthy``; ``per_class``: called each fault class) at the rate the model calls its
     validation session's (``validation_runs`` of ``validation``, read as in training) healthy
-    windows. Sets it on ``model``; returns it with a record."""
-    check_recipe(recipe)
+    windows, or at ``healthy_rate`` where that is stricter. Sets it on ``model``; returns it
+    with a record."""
+    check_recipe(recipe, healthy_rate)
     model.class_offset.zero_()
     target = healthy_logits(model, validation, window, validation_runs)
     logits = healthy_logits(model, arm, window)
@@ -136,8 +159,15 @@ def match_operating_point(
         record["skipped"] = "no healthy windows to match"
         return offset, record
     rate = float((target.argmax(1) == 0).mean())
-    fit = per_class_offset if recipe == "per_class" else healthy_offset
-    offset = fit(target, logits)
+    if recipe == "per_class":
+        offset = per_class_offset(target, logits, healthy_rate)
+    else:
+        offset = healthy_offset(target, logits)
+    if healthy_rate is not None:  # what the quieter operating point costs, on validation
+        faulted = healthy_logits(model, validation, window, validation_runs, faulted=True)
+        record["healthy_rate_asked"] = healthy_rate
+        record["validation_fault_recall_before"] = float((faulted.argmax(1) != 0).mean())
+        record["validation_fault_recall_after"] = float(((faulted + offset).argmax(1) != 0).mean())
     model.class_offset.copy_(torch.from_numpy(offset))
     record.update({
         "validation_healthy_rate": rate,

@@ -13,11 +13,12 @@ import pytest
 from robohealth_mj import schema
 from robohealth_mj.commission import main as commission_main
 from robohealth_mj.common.config import compose_config
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.baseline import RESIDUALS, basis
 from robohealth_mj.data.windows import make_windows
 from robohealth_mj.deploy.commission import commission
-from robohealth_mj.deploy.operating_point import per_class_offset
+from robohealth_mj.deploy.operating_point import check_recipe, per_class_offset
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
 from robohealth_mj.recording.recorder import record_session
 from robohealth_mj.runtime.metadata import read_metadata
@@ -159,6 +160,28 @@ def test_per_class_matching_lowers_only_what_healthy_running_is_mistaken_for():
     assert (called == 2).mean() <= 1 / 200  # validation never calls friction: one window
     backlash = np.array([[1.0, 1.2, 0.0, 0.0, 0.0]], np.float32)
     assert (backlash + offset).argmax(1)[0] == 1
+
+
+def test_a_healthy_rate_asked_for_is_stricter_than_validations():
+    """healthy_rate=0.99: each of the four fault classes may take a quarter of the 1 % left
+    (validation's 2 % of jam is no longer enough), and a clear fault is still called; a rate
+    outside (0, 1), or with the healthy recipe, is one line."""
+    rng = np.random.default_rng(1)
+    validation = np.zeros((400, 5), np.float32)
+    validation[:, 0] = 1.0
+    validation[:8, 3] = 2.0  # 2 % called jam
+    arm = np.zeros((400, 5), np.float32)
+    arm[:, 0] = 1.0
+    arm[:, 1:] = rng.uniform(0.0, 1.4, (400, 4))  # every class a little, some above healthy
+    offset = per_class_offset(validation, arm, healthy_rate=0.99)
+    called = (arm + offset).argmax(1)
+    assert (called == 0).mean() >= 0.99 - 1 / 400
+    assert max((called == k).mean() for k in range(1, 5)) <= 0.0025 + 1 / 400
+    assert (np.array([[1.0, 0.0, 0.0, 3.5, 0.0]], np.float32) + offset).argmax(1)[0] == 3
+    assert ((arm + per_class_offset(validation, arm)).argmax(1) == 0).mean() < 0.98
+    for recipe, rate in (("per_class", 1.5), ("healthy", 0.99)):
+        with pytest.raises(InputError, match=r"healthy_rate: a number in \(0, 1\)"):
+            check_recipe(recipe, rate)
 
 
 def test_commissioning_matches_each_fault_class_by_default(deployed, healthy, tmp_path):

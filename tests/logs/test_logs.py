@@ -279,16 +279,20 @@ def test_a_log_without_target_position_is_read_with_the_reduced_profile(tmp_path
     np.testing.assert_allclose(reduced[..., keep], whole[..., keep], rtol=1e-6)
 
 
-def test_a_headerless_log_reads_through_the_map_that_names_its_columns(tmp_path, capsys):
-    """The public UR10e identification layout: 31 numbers a row, no header line."""
+def _headerless(log: Path, signals: tuple[str, ...]) -> tuple[Path, dict, np.ndarray]:
+    """A 3 s, 100 Hz log of these per-joint signals after the time, with no header line."""
     t = np.arange(0, 3.0, 1 / 100.0)
     cols = _rtde(t)
-    order = ["timestamp"] + [f"{c}_{j}" for c in ("actual_q", "actual_qd", "actual_current",
-                                                  "target_current", "target_moment")
-                             for j in range(J)]  # fmt: skip
-    log = tmp_path / "ur-20_01_17-p1.csv"
+    order = ["timestamp"] + [f"{c}_{j}" for c in signals for j in range(J)]
     log.write_text("\n".join(",".join(f"{cols[n][i]:.9g}" for n in order)
                              for i in range(len(t))) + "\n")  # fmt: skip
+    return log, cols, t
+
+
+def test_a_headerless_log_reads_through_the_map_that_names_its_columns(tmp_path, capsys):
+    """The public UR10e identification layout: 31 numbers a row, no header line."""
+    log, cols, t = _headerless(tmp_path / "ur-20_01_17-p1.csv", ("actual_q", "actual_qd",
+                               "actual_current", "target_current", "target_moment"))  # fmt: skip
     cmap, (session,) = convert_log(log)
     assert cmap.name == "ur_rtde_headerless" and session.stats["sensing"] == "stock_reduced"
     assert session.stats["rows"] == len(t)  # the first line is data, not a header
@@ -303,13 +307,8 @@ def test_a_headerless_log_reads_through_the_map_that_names_its_columns(tmp_path,
 def test_the_short_headerless_layout_reads_without_the_targets(tmp_path, capsys):
     """The same logs' earlier layout: 19 numbers a row (time, positions, velocities, currents),
     read with the joint_states profile, and ingest says what it dropped and why."""
-    t = np.arange(0, 3.0, 1 / 100.0)
-    cols = _rtde(t)
-    order = ["timestamp"] + [f"{c}_{j}" for c in ("actual_q", "actual_qd", "actual_current")
-                             for j in range(J)]  # fmt: skip
-    log = tmp_path / "ur-19_09_27-11_28_22.csv"
-    log.write_text("\n".join(",".join(f"{cols[n][i]:.9g}" for n in order)
-                             for i in range(len(t))) + "\n")  # fmt: skip
+    log, cols, _ = _headerless(tmp_path / "ur-19_09_27-11_28_22.csv",
+                               ("actual_q", "actual_qd", "actual_current"))  # fmt: skip
     cmap, (session,) = convert_log(log)
     assert cmap.name == "ur_rtde_headerless_short" and session.stats["sensing"] == "joint_states"
     np.testing.assert_allclose(session.state[:, 2, 2], cols["actual_current_2"][::5] * 9.65,
