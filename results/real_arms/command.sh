@@ -20,6 +20,8 @@ $CAMPAIGN --curriculum replay                        # the arm's own program rep
 $CAMPAIGN --curriculum mixed                         # both corpora
 $CAMPAIGN --curriculum programs                      # sweeps and pendant-taught point-to-point
 $CAMPAIGN --curriculum programs --healthy-rate 0.99
+$PY experiments/real_arms/campaign.py --curriculum standard --name standard_e30 --variants stgnn_fixed --epochs 30
+$PY experiments/real_arms/campaign.py --curriculum standard --name standard_e30 --variants stgnn_fixed --epochs 30 --healthy-rate 0.99
 # the twin without its identified effort noise (the ablation of effort_noise_nm)
 $PY -c "import yaml; t = yaml.safe_load(open('outputs/real_arms/twin/twin.yaml')); t['effort_noise_nm'] = None; yaml.safe_dump(t, open('outputs/real_arms/twin_without_noise.yaml', 'w'), sort_keys=False)"
 $CAMPAIGN --curriculum replay --twin outputs/real_arms/twin_without_noise.yaml --name replay_twin_without_noise
