@@ -50,7 +50,8 @@ def waveform(name: str, phi: np.ndarray) -> np.ndarray:
     return _raw_waveform(name, phi) / _slope_norm(name)
 
 
-def _smoothstep(u: np.ndarray) -> np.ndarray:
+def smoothstep(u: np.ndarray) -> np.ndarray:
+    """The quintic from 0 to 1 on [0, 1] with zero slope and curvature at both ends."""
     u = np.clip(u, 0.0, 1.0)
     return u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
 
@@ -220,7 +221,7 @@ class Curriculum:
         out = np.repeat(poses[:1], len(tau), axis=0)
         t0 = dwell
         for k, leg in enumerate(legs):
-            u = _smoothstep((tau[:, 0] - t0) / leg)[:, None]
+            u = smoothstep((tau[:, 0] - t0) / leg)[:, None]
             out = out + (poses[k + 1] - poses[k]) * u
             t0 += leg + dwell
         return out
@@ -252,8 +253,8 @@ class Curriculum:
         tau = np.asarray(t, dtype=float)[:, None] - sched.t_start
         if seg.family == "pick_place":
             return self._point_to_point(visit, tau)
-        blend = _smoothstep(tau / self.blend_s)
-        envelope = blend * _smoothstep((self.segment_s - tau) / self.blend_s)
+        blend = smoothstep(tau / self.blend_s)
+        envelope = blend * smoothstep((self.segment_s - tau) / self.blend_s)
         omega = 2.0 * np.pi * self.base_frequency_hz * seg.speed_scale
         # Subtracting each joint's value at its phase offset keeps the motion zero at rest, so the
         # envelope alone shapes the start and the stop.

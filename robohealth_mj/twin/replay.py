@@ -22,7 +22,7 @@ from scipy.signal import butter, sosfiltfilt
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import N_JOINTS
 from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
-from robohealth_mj.sim.curriculum import ScheduledSegment, Segment
+from robohealth_mj.sim.curriculum import ScheduledSegment, Segment, smoothstep
 from robohealth_mj.twin.joint_log import read_joint_log
 
 GRID_HZ = 100.0  # the program is built on this grid before the spline joins it up
@@ -44,9 +44,8 @@ def _move(start: np.ndarray, end: np.ndarray, limits: np.ndarray, shortest_s: fl
     """A quintic move from rest to rest on the grid (excluding its start), at most MOVE_SPEED of
     each joint's limit (a quintic's peak speed is 1.875 x distance / duration)."""
     duration = max(shortest_s, float(np.max(1.875 * np.abs(end - start) / (MOVE_SPEED * limits))))
-    u = np.arange(1, int(np.ceil(duration * GRID_HZ)) + 1) / np.ceil(duration * GRID_HZ)
-    s = u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
-    return start + (end - start) * s[:, None]
+    steps = int(np.ceil(duration * GRID_HZ))
+    return start + (end - start) * smoothstep(np.arange(1, steps + 1) / steps)[:, None]
 
 
 class ReplayCurriculum:
@@ -92,7 +91,7 @@ class ReplayCurriculum:
         self.seed = int(seed)
         logs = [_filtered_positions(f, column_map, cutoff_hz) for f in self.files]
         self._build(logs, limits, int(passes), float(hold_s), float(blend_s))
-        self._check_speed(logs, limits)
+        self._check_speed(limits)
 
     def _build(
         self, logs: list[np.ndarray], limits: np.ndarray, passes: int, hold_s: float, blend_s: float
@@ -119,9 +118,10 @@ class ReplayCurriculum:
         q = np.concatenate(pieces)
         q[-1] = q[0]  # exactly periodic
         self.period_s = (len(q) - 1) / GRID_HZ
+        self._starts = np.array([start for start, _, _ in self._plays])
         self._spline = CubicSpline(np.arange(len(q)) / GRID_HZ, q, bc_type="periodic")
 
-    def _check_speed(self, logs: list[np.ndarray], limits: np.ndarray) -> None:
+    def _check_speed(self, limits: np.ndarray) -> None:
         t = np.arange(0.0, self.period_s, 1.0 / GRID_HZ)
         peak = np.abs(self._spline(t, 1)).max(axis=0)
         over = np.flatnonzero(peak > limits)
@@ -141,8 +141,7 @@ class ReplayCurriculum:
     def _play_at(self, t: float) -> tuple[int, int, float]:
         """Which play of the program sounds at session time ``t``: (index, log, speed scale)."""
         local = t % self.period_s
-        starts = [p[0] for p in self._plays]
-        i = max(int(np.searchsorted(starts, local, side="right")) - 1, 0)
+        i = max(int(np.searchsorted(self._starts, local, side="right")) - 1, 0)
         return i, self._plays[i][1], self._plays[i][2]
 
     def scheduled(self, visit: int) -> ScheduledSegment:
