@@ -7,8 +7,9 @@
     python -m robohealth_mj.bench infer [--data outputs/corpus/quick/heldout_seed900] [--window 32]
     python -m robohealth_mj.bench infer --model results/headline_physics/<model>.onnx
     python -m robohealth_mj.bench streams [--model M] [--streams 1000] [--seconds 30]
+    python -m robohealth_mj.bench streams --profile 1000 2000 [--shards 1]
     python -m robohealth_mj.bench soak [--model M] [--streams 1000] [--seconds 60]
-    python -m robohealth_mj.bench ros2 --model M [--arms 10 25 50] [--seconds 20]
+    python -m robohealth_mj.bench ros2 --model M [--arms 10 25 50] [--seconds 20] [--monitors 1 2]
 
 ``sim`` measures, in one run, the raw ``mj_step`` rate of the scene and the recorder's throughput
 (physics + control + sensor synthesis + JSONL writing), and reports their ratio. ``train
@@ -69,13 +70,30 @@ def main(argv: list[str] | None = None) -> None:
     ros2.add_argument("--arms", type=int, nargs="+", default=[10, 25, 50])
     ros2.add_argument("--seconds", type=float, default=20.0)
     ros2.add_argument("--layouts", nargs="+", default=["per_sensor", "aggregated"])
+    ros2.add_argument(
+        "--monitors", type=int, nargs="+", default=[1],
+        help="monitor processes sharing the arms (ros2.partition=k/n), one row per count",
+    )  # fmt: skip
+    ros2.add_argument(
+        "--health-hz", type=float, default=20.0, help="each arm's /health_diagnosis rate"
+    )
     for p, seconds in ((streams, 30.0), (soak, 60.0)):
         p.add_argument("--model", default=headline)
         p.add_argument("--data", nargs="+", default=["outputs/corpus/standard/heldout_seed900"])
         p.add_argument("--streams", type=int, default=1000)
         p.add_argument("--seconds", type=float, default=seconds, help="paced run length")
         p.add_argument("--shards", type=int, default=2, help="threads the fleet step uses")
+        p.add_argument("--chunk", type=int, default=256, help="streams per model call")
     streams.add_argument("--no-search", action="store_true", help="skip the stream-count search")
+    streams.add_argument(
+        "--profile",
+        type=int,
+        nargs="+",
+        default=None,
+        metavar="STREAMS",
+        help="instead of the search: where each tick's time goes at these stream counts",
+    )
+    streams.add_argument("--profile-ticks", type=int, default=100, help="ticks per profile")
     streams.add_argument(
         "--memory-horizon",
         type=float,
@@ -92,7 +110,8 @@ def main(argv: list[str] | None = None) -> None:
     if args.what == "ros2":
         from robohealth_mj.benchmarks.ros2 import bench_ros2
 
-        bench_ros2(args.model, args.data, args.arms, args.seconds, args.layouts)
+        bench_ros2(args.model, args.data, args.arms, args.seconds, args.layouts, args.monitors,
+                   args.health_hz)  # fmt: skip
     elif args.what in ("streams", "soak"):
         from robohealth_mj.benchmarks.fleet import bench_fleet, bench_soak
 

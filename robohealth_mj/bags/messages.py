@@ -57,6 +57,36 @@ def stamp_ns(t: float) -> int:
     return round(t * 1e9)
 
 
+def health_fields(d: Any, classes: list[str], joints: list[str]) -> tuple[int, str, dict]:
+    """A ``HealthDiagnosis`` as a ``DiagnosticStatus``'s level, message and key values: level
+    from the alarm (OK: none, WARN: a fault decided without an alarm, or an invalid sample,
+    ERROR: an alarm up); class, joint, confidence, alarm state and per-class and per-joint
+    scores as text."""
+    if d.alarm_class is not None:
+        level, message = 2, f"ALARM {d.alarm_class} @ {d.alarm_joint} ({d.alarm})"
+    elif not d.valid:
+        level, message = 1, f"invalid sample: {d.reason}"
+    elif d.fault_present:
+        level, message = 1, f"{d.fault_class} @ {d.localised_joint} (no alarm)"
+    elif d.fault_class is None:
+        level, message = 0, f"no decision: {d.reason}"
+    else:
+        level, message = 0, "healthy"
+    values = {
+        "fault_class": d.fault_class or "",
+        "joint": d.localised_joint or "",
+        "confidence": f"{d.confidence:.4f}",
+        "alarm": str(d.alarm),
+        "alarm_class": d.alarm_class or "",
+        "alarm_joint": d.alarm_joint or "",
+        "valid": str(d.valid).lower(),
+        "sample_index": "" if d.sample_index is None else str(d.sample_index),
+        **{f"p.{c}": f"{d.class_probabilities.get(c, 0.0):.4f}" for c in classes},
+        **{f"score.{j}": f"{d.joint_scores.get(j, 0.0):.4f}" for j in joints},
+    }
+    return level, message, values
+
+
 class MessageFactory:
     """Builds this project's messages with the ROS 2 (Humble) type definitions."""
 
@@ -95,38 +125,14 @@ class MessageFactory:
     def health_status(
         self, d: Any, classes: list[str], joints: list[str], name: str, hardware_id: str
     ) -> Any:
-        """A ``HealthDiagnosis`` as one ``DiagnosticStatus``: level from the alarm (OK: none,
-        WARN: a fault decided without an alarm, or an invalid sample, ERROR: an alarm up);
-        class, joint, confidence, alarm state and per-class and per-joint scores as key values."""
-        status = self.Status
-        if d.alarm_class is not None:
-            level, message = status.ERROR, f"ALARM {d.alarm_class} @ {d.alarm_joint} ({d.alarm})"
-        elif not d.valid:
-            level, message = status.WARN, f"invalid sample: {d.reason}"
-        elif d.fault_present:
-            level, message = status.WARN, f"{d.fault_class} @ {d.localised_joint} (no alarm)"
-        elif d.fault_class is None:
-            level, message = status.OK, f"no decision: {d.reason}"
-        else:
-            level, message = status.OK, "healthy"
-        values = {
-            "fault_class": d.fault_class or "",
-            "joint": d.localised_joint or "",
-            "confidence": f"{d.confidence:.4f}",
-            "alarm": d.alarm,
-            "alarm_class": d.alarm_class or "",
-            "alarm_joint": d.alarm_joint or "",
-            "valid": str(d.valid).lower(),
-            "sample_index": "" if d.sample_index is None else d.sample_index,
-            **{f"p.{c}": f"{d.class_probabilities.get(c, 0.0):.4f}" for c in classes},
-            **{f"score.{j}": f"{d.joint_scores.get(j, 0.0):.4f}" for j in joints},
-        }
+        """A ``HealthDiagnosis`` as one ``DiagnosticStatus`` (see :func:`health_fields`)."""
+        level, message, values = health_fields(d, classes, joints)
         return self.Status(
             level=np.uint8(level),
             name=name,
             message=message,
             hardware_id=hardware_id,
-            values=[self.KeyValue(key=k, value=str(v)) for k, v in values.items()],
+            values=[self.KeyValue(key=k, value=v) for k, v in values.items()],
         )
 
     def health_diagnosis(self, d: Any, classes: list[str], joints: list[str]) -> Any:
@@ -258,6 +264,13 @@ def sample_from_aggregated(t: float, array: Any, fault: Any, where) -> GraphSamp
     return GraphSample(run_id, index, t, x, label, segment)
 
 
+# where an IMU's acceleration and a vibration array's values go among the sensor channels
+_SENSOR_COLUMNS = [
+    FEATURE_NAMES.index(name) - SENSOR_CHANNELS.start
+    for name in ("acc_x", "acc_y", "acc_z", *VIBRATION_FIELDS)
+]
+
+
 def sample_from_messages(
     t: float,
     state: Any,
@@ -288,14 +301,14 @@ def sample_from_messages(
             columns.append(values if order is None else np.asarray(values)[order])
     joint_state = np.stack(columns, axis=-1)
     sensor = np.zeros((N_JOINTS, SENSOR_CHANNELS.stop - SENSOR_CHANNELS.start))
-    vib_at = [FEATURE_NAMES.index(v) - SENSOR_CHANNELS.start for v in VIBRATION_FIELDS]
-    acc_at = [FEATURE_NAMES.index(a) - SENSOR_CHANNELS.start for a in ("acc_x", "acc_y", "acc_z")]
+    rows = []
     for j, (imu, vib) in enumerate(zip(imus or (), vibs or (), strict=True)):
         a = imu.linear_acceleration
-        sensor[j, acc_at] = (a.x, a.y, a.z)
         if len(vib.data) != len(VIBRATION_FIELDS):
             raise where(("vibration", j), f"field 'data': {len(vib.data)} values, not 5")
-        sensor[j, vib_at] = vib.data
+        rows.append((a.x, a.y, a.z, *vib.data))
+    if rows:  # every joint's acceleration and vibration channels, in one assignment
+        sensor[:, _SENSOR_COLUMNS] = rows
     x = node_features(joint_state, sensor).astype(np.float32)
     if fault is None:
         return GraphSample("", 0, t, x, FaultLabel(), dict(UNLABELLED_SEGMENT))

@@ -19,17 +19,77 @@ def latency_ms(fn, calls: int = 200, warmup: int = 10) -> tuple[float, float]:
     return float(np.median(times)), float(np.percentile(times, 95))
 
 
-def matmul_rate(seconds: float = 2.0, n: int = 1024) -> float:
-    """Single-precision matmul FLOP/s of this machine (all torch threads)."""
-    import torch
-
-    a, b = torch.randn(n, n), torch.randn(n, n)
+def _product_rate(a, b, seconds: float) -> float:
+    """FLOP/s of ``a @ b`` (square, n x n) repeated for ``seconds`` after one warm-up."""
     a @ b
     calls, start = 0, time.perf_counter()
     while time.perf_counter() - start < seconds:
         a @ b
         calls += 1
-    return 2.0 * n**3 * calls / (time.perf_counter() - start)
+    return 2.0 * a.shape[0] ** 3 * calls / (time.perf_counter() - start)
+
+
+def matmul_rate(seconds: float = 2.0, n: int = 1024) -> float:
+    """Single-precision matmul FLOP/s of this machine (all torch threads)."""
+    import torch
+
+    return _product_rate(torch.randn(n, n), torch.randn(n, n), seconds)
+
+
+def sgemm_rate(seconds: float = 2.0, n: int = 1024) -> float:
+    """Single-precision matmul FLOP/s of this machine through numpy's BLAS (all its threads):
+    the torch-free deployment install's yardstick."""
+    rng = np.random.default_rng(0)
+    return _product_rate(rng.random((n, n), np.float32), rng.random((n, n), np.float32), seconds)
+
+
+def onnx_flops(session_factory, model: bytes | str, feeds: dict[str, np.ndarray]) -> float:
+    """Multiply-add FLOPs (MatMul, Gemm, Einsum; 2 per multiply-add) of one run of an ONNX model
+    on ``feeds``, read off onnxruntime's own profile of that run: the shapes each node saw.
+    ``session_factory(model, options)`` opens the session (so the caller picks providers)."""
+    import json
+    import os
+
+    import onnx
+    import onnxruntime as ort
+
+    proto = onnx.load_from_string(model) if isinstance(model, bytes) else onnx.load(model)
+    equations = {
+        n.name: onnx.helper.get_attribute_value(n.attribute[0]).decode()
+        for n in proto.graph.node
+        if n.op_type == "Einsum"
+    }
+    options = ort.SessionOptions()
+    options.enable_profiling = True
+    options.graph_optimization_level = ort.GraphOptimizationLevel.ORT_DISABLE_ALL
+    session = session_factory(model, options)
+    session.run(None, feeds)
+    path = session.end_profiling()
+    try:
+        with open(path) as f:
+            events = json.load(f)
+    finally:
+        os.remove(path)
+    total = 0.0
+    for e in events:
+        args = e.get("args", {})
+        op = args.get("op_name")
+        if e.get("cat") != "Node" or op not in ("MatMul", "Gemm", "Einsum"):
+            continue
+        shapes = [next(iter(d.values())) for d in args["input_type_shape"]]
+        out = next(iter(args["output_type_shape"][0].values()))
+        if op == "Einsum":
+            sizes: dict[str, int] = {}
+            terms = equations[e["name"].removesuffix("_kernel_time")].split("->")[0].split(",")
+            for term, shape in zip(terms, shapes, strict=True):
+                sizes.update(zip(term, shape, strict=True))
+            total += 2.0 * float(np.prod(list(sizes.values())))
+        else:
+            rows = float(np.prod(out[:-1]))
+            a = shapes[0]
+            inner = float(np.prod(a)) / rows if op == "MatMul" else float(np.prod(a)) / out[0]
+            total += 2.0 * rows * out[-1] * inner
+    return total
 
 
 def fresh_variant(name: str, window: int, *overrides: str):

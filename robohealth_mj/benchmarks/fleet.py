@@ -7,10 +7,14 @@ import os
 
 import numpy as np
 
+from robohealth_mj.benchmarks.common import onnx_flops, sgemm_rate
 from robohealth_mj.benchmarks.soak import soak
 from robohealth_mj.benchmarks.streams import TICK_S, search, trial
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import FleetRuntime, freeze_startup_heap
+from robohealth_mj.runtime.phases import PhaseClock
+
+ONNX_PHASES = ("encode (ONNX)", "head (ONNX)")
 
 
 def _frames(data: list[str]):
@@ -26,6 +30,78 @@ def _row(label: str, r: dict) -> str:
     )
 
 
+def model_flops(model: str, incremental: bool = True) -> float:
+    """FLOPs the fleet step's ONNX calls perform per stream and tick (both incremental graphs,
+    or the windowed graph on one window)."""
+    import base64
+
+    import onnxruntime as ort
+
+    from robohealth_mj import schema
+    from robohealth_mj.runtime.metadata import read_metadata
+
+    meta = read_metadata(model)
+
+    def session(m, options):
+        return ort.InferenceSession(m, options, providers=["CPUExecutionProvider"])
+
+    def zeros(*shape):
+        return np.zeros(shape, np.float32)
+
+    nodes, features = schema.N_NODES, schema.N_FEATURES
+    if not incremental or "incremental_encode" not in meta:
+        return onnx_flops(session, model, {"x": zeros(1, int(meta["window"]), nodes, features)})
+    g, f0 = int(meta["incremental_channels"]), int(meta["first_signal"])
+    views = 3 * g + 7 * (features - f0) + f0
+    snapshot = zeros(1, nodes, features)
+    encode = onnx_flops(
+        session, base64.b64decode(meta["incremental_encode"]),
+        {"x_new": snapshot, "z_prev": snapshot, "z_first": snapshot, "has_prev": zeros(1)},
+    )  # fmt: skip
+    head = onnx_flops(
+        session, base64.b64decode(meta["incremental_head"]),
+        {"views": zeros(1, nodes, views), "z_last": snapshot},
+    )  # fmt: skip
+    return encode + head
+
+
+def bench_profile(args: argparse.Namespace, x: np.ndarray) -> list[dict]:
+    """Where the fleet step's time goes at each ``--profile`` stream count (unpaced), and the
+    ONNX calls' FLOP rate against numpy's matmul rate measured in the same run."""
+    cores = os.cpu_count() or 1
+    flops = model_flops(args.model)
+    peak = sgemm_rate()
+    print(
+        f"\nprofile: {flops / 1e6:.3f} MFLOP per stream and tick in the ONNX calls; numpy sgemm "
+        f"{peak / 1e9:.1f} GFLOP/s on {cores} cores ({peak / cores / 1e9:.1f} per core), measured "
+        f"now; {args.profile_ticks} unpaced ticks after the windows fill"
+    )
+    rows = []
+    for streams in args.profile:
+        clock = PhaseClock()
+        r = trial(args.model, x, streams, args.profile_ticks, shards=args.shards, clock=clock,
+                  chunk=args.chunk)  # fmt: skip
+        per_tick = {k: v / args.profile_ticks * 1e3 for k, v in clock.seconds.items()}
+        busy = sum(per_tick.values())
+        onnx_s = sum(per_tick.get(k, 0.0) for k in ONNX_PHASES) / 1e3
+        rate = flops * streams / onnx_s if onnx_s else float("nan")
+        print(
+            f"\n{streams} streams, {args.shards} shard threads, parts of <= {args.chunk}: step "
+            f"p50 {r['p50_ms']:.1f} ms, p99 {r['p99_ms']:.1f} ms; thread time {busy:.1f} ms "
+            "per tick\n"
+            "| phase | thread ms per tick | share |\n|---|---|---|"
+        )
+        for phase, ms in sorted(per_tick.items(), key=lambda kv: -kv[1]):
+            print(f"| {phase} | {ms:.2f} | {ms / busy:.1%} |")
+        print(
+            f"ONNX calls: {rate / 1e9:.1f} GFLOP/s per busy thread = {rate / (peak / cores):.1%} "
+            f"of one core's sgemm rate; the step's thread time is {busy / 1e3 / onnx_s:.2f}x "
+            "the ONNX calls'"
+        )
+        rows.append({**r, "phases_ms": per_tick, "onnx_gflops_per_thread": rate / 1e9})
+    return rows
+
+
 def bench_fleet(args: argparse.Namespace) -> dict:
     """Search the sustained stream count, then a paced run at ``--streams``, then the windowed
     path at the same count; prints a markdown table."""
@@ -35,6 +111,8 @@ def bench_fleet(args: argparse.Namespace) -> dict:
         f"{args.model}; {len(x)} recorded snapshots replayed from random offsets; {cores} cores, "
         f"{args.shards} shard threads; timed: FleetRuntime.step (validate, buffer, infer, alarms)"
     )
+    if args.profile:
+        return {"profile": bench_profile(args, x)}
     found = None
     if not args.no_search:
         print("search (unpaced, 100 ticks each after the windows fill):")

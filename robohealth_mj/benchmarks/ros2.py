@@ -2,7 +2,8 @@
 latency from a robot's publish to the diagnosis on ``/diagnostics``.
 
 Publishers run in a child process (replaying a recording, stamps set to the wall clock at publish,
-so the monitor reads each sample's age directly); the monitor runs here. CPU is reported apart
+so the monitor reads each sample's age directly); the monitors run in their own processes, each
+a share of the arms (scale-out: ``--monitors 1 2``). CPU is reported apart
 for each side (process time over wall time, in cores)."""
 
 from __future__ import annotations
@@ -37,9 +38,9 @@ def _publisher(
             time.sleep(delay)
         base = samples[tick % len(samples)]
         sample = base.__class__("bench", tick, time.time(), base.x, base.fault, base.segment)
-        built = [m for _, m in pubs[0].messages(sample, topics)]  # stamped now
+        built = pubs[0].serialized([m for _, m in pubs[0].messages(sample, topics)])  # stamped now
         for pub in pubs:
-            pub.publish_built(built)
+            pub.publish_serialized(built)
     out.put(
         {
             "ticks": ticks,
@@ -50,65 +51,104 @@ def _publisher(
     time.sleep(1.0)
 
 
-def run_once(
-    model: str, samples: list, arms: int, seconds: float, domain: int, layout: str
-) -> dict[str, Any]:
+def _monitor(
+    domain: int, model: str, arms: list[str], seconds: float, layout: str, expected: int,
+    health_hz: float, ready, go, out,
+) -> None:  # fmt: skip
+    """One monitor process: its share of the arms, until every sample came or time ran out."""
     from robohealth_mj.ros2.bus import Bus, BusConfig
     from robohealth_mj.ros2.node import MonitorNode
     from robohealth_mj.runtime.runtime import ModelRuntime
 
-    ctx = mp.get_context("spawn")
-    ready, go, out = ctx.Event(), ctx.Event(), ctx.Queue()
-    child = ctx.Process(
-        target=_publisher, args=(domain, arms, samples, seconds, layout, ready, go, out)
-    )
-    child.start()
     latencies: list[float] = []
 
     def on_diagnosis(arm: str, sample, d) -> None:
         latencies.append(time.time() - sample.t)
 
     bus = Bus(BusConfig(domain_id=domain, interface="127.0.0.1", depth=50))
-    arm_names = [f"arm{k + 1}" for k in range(arms)]
-    node = MonitorNode(
-        bus, ModelRuntime(model), arm_names, on_diagnosis=on_diagnosis, layout=layout
-    )
-    ready.wait(60)
-    time.sleep(1.5)  # discovery
-    go.set()
+    node = MonitorNode(bus, ModelRuntime(model), arms, on_diagnosis=on_diagnosis, layout=layout,
+                       health_diagnosis_hz=health_hz)  # fmt: skip
+    ready.set()
+    go.wait()
     cpu0, wall0 = time.process_time(), time.perf_counter()
-    deadline = wall0 + seconds + 2.0
-    expected = int(seconds * 20) * arms
+    deadline = wall0 + seconds + 3.5
     while time.perf_counter() < deadline and sum(s.samples for s in node.arms.values()) < expected:
         if not node.poll():
             time.sleep(0.005)  # as the monitor's default poll_s
     wall = time.perf_counter() - wall0
-    cpu = time.process_time() - cpu0
-    published = out.get(timeout=30)
-    child.join(10)
+    out.put({
+        "diagnosed": sum(s.samples for s in node.arms.values()),
+        "problems": sum(s.problems for s in node.arms.values()),
+        "latencies": latencies,
+        "cpu_cores": (time.process_time() - cpu0) / wall,
+        "seconds": {k: v / wall for k, v in node.seconds.items()},
+    })  # fmt: skip
     bus.close()
-    got = sum(s.samples for s in node.arms.values())
-    problems = sum(s.problems for s in node.arms.values())
+
+
+def run_once(
+    model: str, samples: list, arms: int, seconds: float, domain: int, layout: str,
+    monitors: int = 1, health_hz: float = 20.0,
+) -> dict[str, Any]:  # fmt: skip
+    """Publishers in one child process; ``monitors`` monitor processes, each a stable-hash
+    share of the arms (as ``ros2.partition=k/n`` splits them); CPU per side in cores."""
+    from robohealth_mj.ros2.node import in_partition
+
+    ctx = mp.get_context("spawn")
+    go, out = ctx.Event(), ctx.Queue()
+    names = [f"arm{k + 1}" for k in range(arms)]
+    ticks = int(seconds * 20)
+    shares = [[a for a in names if in_partition(a, f"{k}/{monitors}" if monitors > 1 else None)]
+              for k in range(monitors)]  # fmt: skip
+    children, readies, results = [], [], ctx.Queue()
+    for share in shares:
+        ready = ctx.Event()
+        children.append(ctx.Process(target=_monitor, args=(
+            domain, model, share, seconds, layout, ticks * len(share), health_hz, ready, go,
+            results)))  # fmt: skip
+        readies.append(ready)
+    publisher_ready = ctx.Event()
+    children.append(ctx.Process(
+        target=_publisher, args=(domain, arms, samples, seconds, layout, publisher_ready, go, out)
+    ))  # fmt: skip
+    for child in children:
+        child.start()
+    for ready in [*readies, publisher_ready]:
+        ready.wait(120)
+    time.sleep(1.5)  # discovery
+    go.set()
+    published = out.get(timeout=seconds + 60)
+    parts = [results.get(timeout=seconds + 60) for _ in shares]
+    for child in children:
+        child.join(10)
+    got = sum(p["diagnosed"] for p in parts)
+    latencies = [v for p in parts for v in p["latencies"]]
     lat = np.array(latencies) * 1e3 if latencies else np.array([np.nan])
+    phases: dict[str, float] = {}
+    for p in parts:
+        for k, v in p["seconds"].items():
+            phases[k] = phases.get(k, 0.0) + v
     return {
         "arms": arms,
+        "monitors": monitors,
         "messages_per_s": arms * (15 if layout == "per_sensor" else 2) * 20,
         "published_samples": published["ticks"] * arms,
         "diagnosed": got,
         "lost": published["ticks"] * arms - got,
-        "problems": problems,
+        "problems": sum(p["problems"] for p in parts),
         "latency_p50_ms": float(np.percentile(lat, 50)),
         "latency_p99_ms": float(np.percentile(lat, 99)),
-        "monitor_cpu_cores": cpu / wall,
+        "monitor_cpu_cores": sum(p["cpu_cores"] for p in parts),
         "publisher_cpu_cores": published["cpu_cores"],
         "publisher_late_s": published["late_s"],
-        "monitor_seconds": {k: v / wall for k, v in node.seconds.items()},  # cores per phase
+        "monitor_seconds": phases,  # cores per phase, summed over the monitors
     }
 
 
 def bench_ros2(
-    model: str, data: str, arms_list: list[int], seconds: float, layouts: list[str]
-) -> list[dict]:
+    model: str, data: str, arms_list: list[int], seconds: float, layouts: list[str],
+    monitors: list[int] | None = None, health_hz: float = 20.0,
+) -> list[dict]:  # fmt: skip
     from robohealth_mj.data.arrays import resolve_recordings
     from robohealth_mj.data.read import read_samples
 
@@ -116,15 +156,15 @@ def bench_ros2(
     domains = itertools.count(150)
     rows = []
     print(
-        f"{'layout':>10} {'arms':>5} {'msg/s':>7} {'lost':>6} {'bad':>4} {'p50 ms':>7} "
+        f"{'layout':>10} {'mon':>3} {'arms':>5} {'msg/s':>7} {'lost':>6} {'bad':>4} {'p50 ms':>7} "
         f"{'p99 ms':>7} {'monitor CPU':>11} {'publisher CPU':>13}   monitor time by phase"
     )
-    for layout, arms in itertools.product(layouts, arms_list):
-        r = run_once(model, samples, arms, seconds, next(domains), layout)
+    for layout, n, arms in itertools.product(layouts, monitors or [1], arms_list):
+        r = run_once(model, samples, arms, seconds, next(domains), layout, n, health_hz)
         r["layout"] = layout
         rows.append(r)
         print(
-            f"{layout:>10} {r['arms']:>5} {r['messages_per_s']:>7} {r['lost']:>6} "
+            f"{layout:>10} {n:>3} {r['arms']:>5} {r['messages_per_s']:>7} {r['lost']:>6} "
             f"{r['problems']:>4} {r['latency_p50_ms']:>7.1f} {r['latency_p99_ms']:>7.1f} "
             f"{r['monitor_cpu_cores']:>10.2f}c {r['publisher_cpu_cores']:>12.2f}c   "
             + "  ".join(f"{k} {v:.2f}c" for k, v in r["monitor_seconds"].items()),

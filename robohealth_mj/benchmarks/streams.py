@@ -17,6 +17,7 @@ import numpy as np
 
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime, freeze_startup_heap
+from robohealth_mj.runtime.phases import PhaseClock
 
 TICK_S = 0.05
 
@@ -86,11 +87,14 @@ def trial(
     shards: int = 2,
     paced: bool = False,
     evidence: EvidencePolicy | None = None,
+    clock: PhaseClock | None = None,
+    chunk: int = 256,
 ) -> dict[str, float]:
-    """A fresh runtime with ``streams`` streams: fill the windows, then time ``ticks`` ticks."""
+    """A fresh runtime with ``streams`` streams: fill the windows, then time ``ticks`` ticks
+    (with ``clock``, also where each tick's time went)."""
     fleet = FleetRuntime(
         model, threads=threads, shards=shards, incremental=incremental, capacity=streams,
-        max_streams=streams, evidence=evidence,
+        max_streams=streams, evidence=evidence, chunk=chunk,
     )  # fmt: skip
     if fleet.engine is None:
         raise ValueError(fleet.problem)
@@ -99,6 +103,8 @@ def trial(
     freeze_startup_heap()
     try:
         run_ticks(fleet, slots, replay, 0, fleet.window + 2)  # warm-up: every window full
+        if clock is not None:
+            fleet.clock = clock
         return {
             "streams": streams,
             "mode": fleet.mode,

@@ -137,6 +137,23 @@ class Bus:
         reliable = self.config.reliable_subscriptions
         return DataReader(self.participant, self._topic(name, cls), self._qos(reliable))
 
+    @staticmethod
+    def serialize(writer: Any, msg: Any) -> bytes:
+        """``msg`` as ``writer`` puts it on the wire (its CDR version, padded to 4 bytes), for
+        :meth:`write_serialized`: a message many writers share is serialised once."""
+        data = msg.serialize(use_version_2=writer._use_version_2)
+        return data.ljust((len(data) + 3) & ~3, b"\0")
+
+    @staticmethod
+    def write_serialized(writer: Any, data: bytes) -> None:
+        """Write bytes from :meth:`serialize` (the binding's ``write`` without serialising)."""
+        from cyclonedds._clayer import ddspy_write
+        from cyclonedds.core import DDSException
+
+        ret = ddspy_write(writer._ref, data)
+        if ret < 0:
+            raise DDSException(ret, f"Occurred while writing sample in {writer!r}")
+
     def close(self) -> None:
         """Delete the participant (and with it every reader, writer and topic)."""
         self._topics.clear()

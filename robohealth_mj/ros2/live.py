@@ -110,6 +110,7 @@ def run_monitor(
     bus = Bus(bus_config(cfg))
     node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
                        stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
+                       health_diagnosis_hz=float(cfg.get("health_diagnosis_hz", 20.0)),
                        **layout_options(cfg, tracking))  # fmt: skip
     started = time.monotonic()
     last_report = started

@@ -16,11 +16,13 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from robohealth_mj.bags.joints import joint_names as arm_joint_names
-from robohealth_mj.bags.messages import MessageFactory
+from robohealth_mj.bags.messages import MessageFactory, health_fields, stamp_ns
 from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.ros2 import layout_sensing
-from robohealth_mj.ros2.assembly import ArmAssembler
+from robohealth_mj.ros2.assembly import ArmAssembler, Assembled
 from robohealth_mj.ros2.bus import Bus
+from robohealth_mj.ros2.cdr import encode_diagnostic_array, take
 from robohealth_mj.ros2.driver import DriverAssembler, DriverConfig, DriverMessages
 from robohealth_mj.ros2.idl import CONTROLLER_STATES, TYPES, IdlStore
 from robohealth_mj.schema import GraphSample
@@ -132,11 +134,16 @@ class ArmPublisher:
         for topic, msg in self.messages(sample):
             self.writers[topic].write(msg)
 
-    def publish_built(self, messages: list[Any]) -> None:
-        """Messages already built for one tick (in ``sample_topics`` order), shared by arms that
-        replay the same sample: the benchmark's publishers build once and write N times."""
-        for writer, msg in zip(self.writers.values(), messages, strict=True):
-            writer.write(msg)
+    def serialized(self, messages: list[Any]) -> list[bytes]:
+        """One tick's messages (in ``sample_topics`` order) as this arm's writers put them on
+        the wire, for :meth:`publish_serialized`."""
+        return [Bus.serialize(w, m) for w, m in zip(self.writers.values(), messages, strict=True)]
+
+    def publish_serialized(self, data: list[bytes]) -> None:
+        """Bytes from :meth:`serialized`, shared by arms that replay the same sample: the
+        benchmark's publishers serialise once and write N times."""
+        for writer, blob in zip(self.writers.values(), data, strict=True):
+            Bus.write_serialized(writer, blob)
 
 
 @dataclass
@@ -174,11 +181,17 @@ class MonitorNode:
         tf_prefix: str = "",
         namespace: str = "/{arm}",
         driver: DriverConfig | None = None,
+        health_diagnosis_hz: float = 20.0,
     ) -> None:
-        """``joint_names`` (a preset of ``conf/joint_names.yaml`` or six names) and ``tf_prefix``
+        """``health_diagnosis_hz``: each arm's ``/health_diagnosis`` at most this often (every
+        diagnosis at the 20 Hz tick; less saves the monitor's publishing time at many arms).
+        ``joint_names`` (a preset of ``conf/joint_names.yaml`` or six names) and ``tf_prefix``
         (``{arm}`` is the arm's name) say what each arm's JointState messages call its joints;
         ``namespace`` where its topics live; ``driver`` the UR driver's side (``ur_driver``)."""
         self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
+        if not health_diagnosis_hz > 0:
+            raise InputError(f"ros2.health_diagnosis_hz must be > 0, got {health_diagnosis_hz}")
+        self.health_every = max(1, round(20.0 / health_diagnosis_hz))  # every k-th diagnosis
         self.keep_diagnoses, self.on_diagnosis = keep_diagnoses, on_diagnosis
         # where the monitor's time goes (the benchmark reports it): take (DDS read and CDR
         # decoding), assemble, diagnose (runtime), publish (the diagnoses' writes)
@@ -219,12 +232,13 @@ class MonitorNode:
         for arm, state in self.arms.items():
             for topic, kind, reader in state.readers:
                 t0 = clock()
-                taken = reader.take(N=max_per_reader)  # the DDS read and CDR decoding
+                taken, undecodable = take(reader, kind, max_per_reader)  # DDS read, CDR decode
                 t1 = clock()
                 self.seconds["take"] += t1 - t0
+                for problem in undecodable:
+                    self._collect(arm, state, Assembled(problems=[f"topic '{topic}': {problem}"]),
+                                  now, submitted)  # fmt: skip
                 for msg in taken:
-                    if not isinstance(msg, kind):
-                        continue  # an instance-state notice (a writer went away), not data
                     self._collect(arm, state, state.assembler.add(topic, msg), now, submitted)
                 self.seconds["assemble"] += clock() - t1
             t1 = clock()  # every reader of the arm taken: now a missing message is missing
@@ -270,11 +284,19 @@ class MonitorNode:
             state.diagnoses.append(d)
         if self.on_diagnosis is not None:
             self.on_diagnosis(arm, sample, d)
+        if (state.samples - 1) % self.health_every:
+            return
         fleet = self.runtime.fleet
         t0 = time.perf_counter()
-        self.diagnosis_writers[arm].write(
-            self.factory.health_diagnosis(d, fleet.classes, fleet.joints)
-        )
+        writer = self.diagnosis_writers[arm]
+        if writer._use_version_2:  # the byte encoder writes XCDR1, as ROS 2 types are
+            writer.write(self.factory.health_diagnosis(d, fleet.classes, fleet.joints))
+        else:
+            level, message, values = health_fields(d, fleet.classes, fleet.joints)
+            data = encode_diagnostic_array(
+                stamp_ns(d.stamp), "", [(level, "health_diagnosis", message, d.model_id, values)]
+            )
+            Bus.write_serialized(writer, data)
         self._publishing += time.perf_counter() - t0
 
     def arm_status(self, arm: str, now: float) -> Any:

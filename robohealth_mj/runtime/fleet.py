@@ -28,6 +28,7 @@ from robohealth_mj import schema
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
+from robohealth_mj.runtime.phases import NO_CLOCK, NoClock
 from robohealth_mj.sim.arms import DEFAULT_ARM
 
 log = logging.getLogger(__name__)
@@ -113,8 +114,10 @@ class FleetRuntime:
         max_gap_s: float = 0.25,
         idle_ticks: int = 1200,
         shards: int = 1,
+        chunk: int = 256,
     ) -> None:
         self.max_streams, self.max_burst = max_streams, max_burst
+        self.chunk = max(1, chunk)
         self.max_gap_s, self.idle_ticks = max_gap_s, idle_ticks
         self.shards, self.threads = max(1, shards), threads
         capacity = max(1, min(capacity, max_streams))
@@ -135,6 +138,19 @@ class FleetRuntime:
         self.ids: dict[str, int] = {}
         self.names: list[str | None] = [None] * capacity
         self.ticks = 0
+        self.clock = NO_CLOCK
+
+    @property
+    def clock(self) -> NoClock:
+        """Where the step's time goes (:class:`~robohealth_mj.runtime.phases.PhaseClock`);
+        measures nothing by default."""
+        return self._clock
+
+    @clock.setter
+    def clock(self, clock: NoClock) -> None:
+        self._clock = clock
+        if self.engine is not None:
+            self.engine.clock = clock
 
     # model
 
@@ -271,6 +287,7 @@ class FleetRuntime:
         layout_ok: np.ndarray | None = None,
     ) -> TickResult:
         """Diagnose one tick's samples (rows); see the module docstring."""
+        self._clock.start()
         slots = np.asarray(slots, np.int64)
         n = len(slots)
         sample_index = np.asarray(sample_index, np.int64)
@@ -305,7 +322,9 @@ class FleetRuntime:
                 final[rows], out, reasons,
             )  # fmt: skip
         self._release_idle()
-        return TickResult(slots, sample_index, t, reasons=reasons, inference_ms=inference, **out)
+        result = TickResult(slots, sample_index, t, reasons=reasons, inference_ms=inference, **out)
+        self._clock.mark("result")
+        return result
 
     def _round(self, rows, slots, index, t, x, known, layout_ok, final, out, reasons) -> float:
         """Rows with distinct slots: validate, buffer, infer (``final`` rows), alarm. Returns
@@ -338,10 +357,12 @@ class FleetRuntime:
             self.engine.reset(gs[gap])
             self.evidence.reset(gs[gap])
         self.last_t[gs], self.last_index[gs] = gt, gi
+        self._clock.mark("validate, bookkeeping")
         start = time.perf_counter()
         decide = final[good]
         full, outputs = self._model_step(gs, x[good], decide)
         elapsed = (time.perf_counter() - start) * 1e3
+        self._clock.start()  # the model step's phases were charged on the threads that ran them
         warming = rows[good][~full & ~gap]
         out["status"][warming] = WARMING
         for k in warming.tolist():
@@ -364,28 +385,36 @@ class FleetRuntime:
         out["accumulated"][target] = accumulated
         out["alarm"][target], out["alarm_class"][target] = state, alarm
         out["alarm_joint"][target] = joint
+        self._clock.mark("evidence, alarms")
         return elapsed
 
     def _model_step(
         self, slots: np.ndarray, x: np.ndarray, decide: np.ndarray
     ) -> tuple[np.ndarray, list[np.ndarray]]:
         """Buffer ``x`` and run the model on the ``decide`` streams whose window is full, in
-        ``shards`` contiguous parts on as many threads (numpy and onnxruntime release the GIL, so
-        the parts run on separate cores). Returns the full mask and the outputs of the rows that
-        are full and decided."""
-        shards = self.shards if len(slots) >= 64 * self.shards else 1  # small: not worth a thread
-        parts = [p for p in np.array_split(np.arange(len(slots)), shards) if len(p)]
+        contiguous parts of at most ``chunk`` streams (at least ``shards`` parts) spread over
+        ``shards`` threads (numba, numpy and onnxruntime release the GIL, so the parts run on
+        separate cores). Returns the full mask and the outputs of the rows that are full and
+        decided."""
+        n = len(slots)
+        shards = self.shards if n >= 64 * self.shards else 1  # small: not worth a thread
+        # parts of at most ``chunk`` streams: each part's arrays stay in the core's cache
+        parts = [
+            p for p in np.array_split(np.arange(n), max(shards, -(-n // self.chunk))) if len(p)
+        ]
         if not parts:
             return np.zeros(0, bool), []
 
         def shard(p: np.ndarray) -> tuple[np.ndarray, list[np.ndarray] | None]:
+            self._clock.start()
             s = slots[p]
             self.engine.push(s, x[p])
             full = self.engine.full(s)
             ready = full & decide[p]
             return full, self.engine.infer(s[ready]) if ready.any() else None
 
-        done = list(self._pool.map(shard, parts)) if len(parts) > 1 else [shard(parts[0])]
+        pool = self._pool if shards > 1 else None
+        done = list(pool.map(shard, parts)) if pool is not None else [shard(p) for p in parts]
         full = np.concatenate([f for f, _ in done])
         outputs = [o for _, o in done if o is not None]
         return full, [np.concatenate(k) for k in zip(*outputs, strict=True)] if outputs else []

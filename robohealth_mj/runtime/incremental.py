@@ -6,8 +6,9 @@ carries:
 - :class:`IncrementalEngine` (models with the incremental form, see
   :mod:`robohealth_mj.models.incremental`): a ring of per-snapshot records per stream and running
   float64 sums, so a tick runs the network on one snapshot and one pooled window. Mean and std
-  come from the sums (float64: drift stays below 1e-12 for years of ticks), min and max from a
-  scan of the ring, ``last - first`` from the ring's two ends.
+  come from the sums (float64: drift stays below 1e-12 for years of ticks), maxima (and minima)
+  from blocks of running maxima (three records a tick, not a scan of the window), ``last - first``
+  from the ring's two ends.
 - :class:`WindowedEngine` (any other model): a ring of raw snapshots written twice, so each
   stream's window is one contiguous slice, and the windowed ONNX model on the gathered windows.
 
@@ -21,18 +22,11 @@ from typing import Any
 
 import numpy as np
 
+from robohealth_mj.runtime import kernels
+from robohealth_mj.runtime.phases import NO_CLOCK
 from robohealth_mj.schema import WINDOW_STATISTICS
 
 NUM_STATISTICS = len(WINDOW_STATISTICS)
-
-
-def rows(slots: np.ndarray) -> slice | np.ndarray:
-    """``slots`` as a slice when it is one ascending run (the whole fleet, usually), so state is
-    read as views instead of gathered copies."""
-    n = len(slots)
-    if n and slots[-1] - slots[0] == n - 1 and (n == 1 or np.all(np.diff(slots) == 1)):
-        return slice(int(slots[0]), int(slots[0]) + n)
-    return slots
 
 
 def _grow(array: np.ndarray, capacity: int) -> np.ndarray:
@@ -48,6 +42,7 @@ class _Engine:
 
     def __init__(self, window: int, capacity: int) -> None:
         self.window = window
+        self.clock = NO_CLOCK  # where push and infer spend their time (bench streams --profile)
         self.head = np.zeros(capacity, dtype=np.int64)  # next ring position to write
         self.count = np.zeros(capacity, dtype=np.int64)  # snapshots in the window (<= W)
 
@@ -74,14 +69,22 @@ class IncrementalEngine(_Engine):
     """Per-snapshot records in rings + running sums; ``encode`` and ``head`` are the exported
     ``SnapshotStep`` and ``PooledHead`` sessions.
 
-    Rings are time-major (``[W, capacity, ...]``), so a window's extremes are elementwise maxima
-    over W contiguous blocks. ``z`` holds the normalised snapshots (for the step to the next one
-    and the window's two ends); ``peaks`` holds what the window takes maxima of, side by side so
-    one scan serves all: the snapshot MLP ``g``, the signals' ``|step|``, the signals and their
-    negation (a minimum is the negated maximum of the negation).
+    A window's statistics come from float64 running sums (means, stds, mean ``|step|``) and from
+    maxima (the snapshot MLP ``g``, ``|step|``, the signals and their negation: a minimum is the
+    negated maximum of the negation). The window's oldest snapshot counts with a zero step and
+    its own ``g_first`` (as the windowed encoder sees it); the W - 1 newer ones count as recorded.
+    Their maximum is kept by blocks of W - 1 snapshots (van Herk / Gil-Werman): a running maximum
+    of the current block (``prefix``) and the suffix maxima of the previous block (``suffix``,
+    computed once when a block completes), so a tick reads three records per stream instead of
+    scanning W. Each stream's block phase is staggered by its slot, so the completions, which
+    cost W - 1 records each, spread evenly over the ticks.
+
+    Rings are time-major (``[W, capacity, ...]``): ``z`` holds the normalised snapshots (for the
+    step to the next one, the signals, the window's two ends), ``raw`` each snapshot's ``g`` and
+    ``|step|`` as recorded (what the sums take back when it becomes the oldest).
     """
 
-    _arrays = ("sum_z", "sq_z", "sum_g", "sq_g", "sum_d")
+    _arrays = ("sum_z", "sq_z", "sum_g", "sq_g", "sum_d", "g_fixed", "prefix", "phase")
 
     def __init__(
         self,
@@ -94,21 +97,46 @@ class IncrementalEngine(_Engine):
         first_signal: int,
         capacity: int,
     ) -> None:
+        if window < 2:
+            raise ValueError(f"the incremental form needs a window of at least 2, not {window}")
         super().__init__(window, capacity)
         self.encode, self.head_session = encode, head
         self.g, self.first, self.s = channels, first_signal, features - first_signal
+        self.block = window - 1
+        record = channels + 3 * self.s  # g, |step|, signal, -signal
         self.z = np.zeros((window, capacity, nodes, features), np.float32)
-        self.peaks = np.zeros((window, capacity, nodes, channels + 3 * self.s), np.float32)
+        self.raw = np.zeros((window, capacity, nodes, channels + self.s), np.float32)
+        # suffix[j]: max over the previous block's positions j..W-2 (the block completed last)
+        self.suffix = np.zeros((self.block, capacity, nodes, record), np.float32)
+        # the current block's running maximum (a block cut short by a reset is never read: a
+        # window fills in W pushes, by when the block it ends in started after the reset)
+        self.prefix = np.zeros((capacity, nodes, record), np.float32)
+        self.g_fixed = np.zeros((capacity, nodes, channels), np.float32)  # the oldest's g_first
+        self.phase = np.arange(capacity, dtype=np.int64) % self.block  # next block position
         self.sum_z = np.zeros((capacity, nodes, self.s))
         self.sq_z = np.zeros((capacity, nodes, self.s))
         self.sum_g = np.zeros((capacity, nodes, channels))
         self.sq_g = np.zeros((capacity, nodes, channels))
         self.sum_d = np.zeros((capacity, nodes, self.s))
+        self._compile()
+
+    def _compile(self) -> None:
+        """Run both kernels on no stream: numba compiles them now (or loads its cache), not
+        inside the first tick."""
+        none, nodes, f = np.zeros(0, np.int64), self.z.shape[2], self.z.shape[3]
+        snapshot = np.zeros((0, nodes, f), np.float32)
+        g = np.zeros((0, nodes, self.g), np.float32)
+        kernels.push_snapshots(
+            none, snapshot, g, g, np.zeros(0, np.float32), self.z, self.raw, self.suffix,
+            self.prefix, self.g_fixed, self.sum_z, self.sq_z, self.sum_g, self.sq_g, self.sum_d,
+            self.head, self.count, self.phase, self.first,
+        )  # fmt: skip
+        self.views(none)
 
     def ensure(self, capacity: int) -> None:
         old = self.capacity
         super().ensure(capacity)
-        for name in ("z", "peaks"):
+        for name in ("z", "raw", "suffix"):
             ring = getattr(self, name)
             if ring.shape[1] < capacity:
                 grown = np.zeros((ring.shape[0], capacity, *ring.shape[2:]), ring.dtype)
@@ -117,117 +145,47 @@ class IncrementalEngine(_Engine):
 
     def reset(self, slots: np.ndarray) -> None:
         super().reset(slots)
-        for name in self._arrays:
+        for name in ("sum_z", "sq_z", "sum_g", "sq_g", "sum_d", "g_fixed"):
             getattr(self, name)[slots] = 0.0
+        self.phase[slots] = np.asarray(slots) % self.block
 
     def push(self, slots: np.ndarray, x: np.ndarray) -> None:
         """Add one raw snapshot ``x [B, 12, F]`` to each stream in ``slots`` (distinct)."""
-        w, g, f0 = self.window, self.g, self.first
-        gd = g + self.s  # the part of a peak record that enters the sums: g and |step|
-        r = rows(slots)
-        h, c = self.head[r], self.count[r]
-        first_pos = (h + 1) % w  # the window's first snapshot once this one is in (when full)
-        z_prev, z_first = self.z[(h - 1) % w, slots], self.z[first_pos, slots]
-        has_prev = (c > 0).astype(np.float32)
+        w = self.window
+        h = self.head[slots]
+        z_prev, z_first = self.z[(h - 1) % w, slots], self.z[(h + 1) % w, slots]
+        has_prev = (self.count[slots] > 0).astype(np.float32)
         z_new, g_new, g_first = self.encode.run(
             None,
             {"x_new": x, "z_prev": z_prev, "z_first": z_first, "has_prev": has_prev},
         )
-        signal = z_new[..., f0:]
-        step = np.abs(signal - z_prev[..., f0:]) * has_prev[:, None, None]
-        record = np.concatenate([g_new, step, signal, -signal], axis=-1)
-        # the record written now replaces the oldest one (nothing while the window fills)
-        old = self.peaks[h, slots]
-        if not (c >= w).all():
-            old = np.where((c >= w)[:, None, None], old, 0.0)
-        self.z[h, slots] = z_new
-        self.peaks[h, slots] = record
-        # the new first snapshot gets a zero step, as the windowed encoder gives it
-        was = self.peaks[first_pos, slots]
-        fixed = np.concatenate([g_first, np.zeros_like(step), was[..., gd:]], axis=-1)
-        if not (c + 1 >= w).all():
-            fixed = np.where((c + 1 >= w)[:, None, None], fixed, was)
-        self.peaks[first_pos, slots] = fixed
-        self._add(r, signal, old[..., gd : gd + self.s])
-        self._add_records(r, record[..., :gd], old[..., :gd], fixed[..., :gd], was[..., :gd])
-        self.head[r] = (h + 1) % w
-        self.count[r] = np.minimum(c + 1, w)
+        self.clock.mark("encode (ONNX)")
+        kernels.push_snapshots(
+            slots, z_new, g_new, g_first, has_prev, self.z, self.raw, self.suffix, self.prefix,
+            self.g_fixed, self.sum_z, self.sq_z, self.sum_g, self.sq_g, self.sum_d, self.head,
+            self.count, self.phase, self.first,
+        )  # fmt: skip
+        self.clock.mark("rings, sums")
 
-    def _add(self, r: slice | np.ndarray, new: np.ndarray, old: np.ndarray) -> None:
-        """Signal sums += new - old (float64)."""
-        n, o = new.astype(np.float64), old.astype(np.float64)
-        self.sum_z[r] += n - o
-        self.sq_z[r] += n * n - o * o
-
-    def _add_records(self, r: slice | np.ndarray, new, old, fixed, was) -> None:
-        """Record sums (g, g^2, |step|) += (new - old) + (fixed - was), in float64."""
-        g = self.g
-        n, o = new.astype(np.float64), old.astype(np.float64)
-        f, v = fixed.astype(np.float64), was.astype(np.float64)
-        delta = n - o
-        delta += f
-        delta -= v
-        self.sum_g[r] += delta[..., :g]
-        self.sum_d[r] += delta[..., g:]
-        ng, og, fg, vg = n[..., :g], o[..., :g], f[..., :g], v[..., :g]
-        self.sq_g[r] += ng * ng - og * og + fg * fg - vg * vg
+    def views(self, slots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The pooled head's inputs for the (full) windows of ``slots``: ``views [B, N, 3G +
+        7S + f0]`` and the newest normalised snapshot ``z_last [B, N, F]``."""
+        b, n, f = len(slots), self.z.shape[2], self.z.shape[3]
+        views = np.empty((b, n, 3 * self.g + 7 * self.s + self.first), np.float32)
+        last = np.empty((b, n, f), np.float32)
+        kernels.fill_views(
+            slots, views, last, self.z, self.head, self.prefix, self.suffix, self.phase,
+            self.g_fixed, self.sum_g, self.sq_g, self.sum_z, self.sq_z, self.sum_d, self.first,
+        )  # fmt: skip
+        return views, last
 
     def infer(self, slots: np.ndarray) -> list[np.ndarray]:
         """The model's outputs for the (full) windows of ``slots``."""
-        w, g, f0, s = self.window, self.g, self.first, self.s
-        r = rows(slots)
-        head = self.head[r]
-        last = self.z[(head - 1) % w, slots]
-        first = self.z[head, slots]  # the oldest slot is the next to write
-        peak = _ring_max(self.peaks, slots, r)  # [B, N, G + 3S]
-        b, n = peak.shape[:2]
-        views = np.empty((b, n, 3 * g + 7 * s + f0), np.float32)  # the encoder's views, in order
-        mean_g = self.sum_g[r] / w
-        views[..., :g] = mean_g
-        views[..., g : 2 * g] = _std(self.sq_g[r] / w, mean_g)
-        views[..., 2 * g : 3 * g] = peak[..., :g]
-        stats = views[..., 3 * g : 3 * g + 7 * s]
-        per_channel = stats.reshape(b, n, s, 7)  # statistics-major within each channel
-        mean_z = self.sum_z[r] / w
-        per_channel[..., 0] = mean_z
-        per_channel[..., 1] = _std(self.sq_z[r] / w, mean_z)
-        per_channel[..., 2] = -peak[..., g + 2 * s :]  # min
-        per_channel[..., 3] = peak[..., g + s : g + 2 * s]  # max
-        per_channel[..., 4] = last[..., f0:] - first[..., f0:]
-        per_channel[..., 5] = self.sum_d[r] / (w - 1)
-        per_channel[..., 6] = peak[..., g : g + s]  # max |step|
-        _asinh(stats)
-        views[..., 3 * g + 7 * s :] = last[..., :f0]
-        return self.head_session.run(None, {"views": views, "z_last": last})
-
-
-def _ring_max(ring: np.ndarray, slots: np.ndarray, r: slice | np.ndarray) -> np.ndarray:
-    """Max over the window axis of the rings of ``slots``. For a selection with few holes (a
-    fleet tick minus its flagged rows) the scan runs over the covering span, contiguous, and the
-    rows are picked afterwards: gathering W records per stream would cost more than the holes."""
-    if isinstance(r, slice):
-        return ring[:, r].max(axis=0)
-    lo, hi = int(slots.min()), int(slots.max()) + 1
-    if hi - lo <= 1.25 * len(slots):
-        return ring[:, lo:hi].max(axis=0)[slots - lo]
-    return ring[:, slots].max(axis=0)
-
-
-def _asinh(x: np.ndarray) -> None:
-    """float32 asinh in place, as ``copysign(log(|x| + sqrt(x^2 + 1)), x)``: numpy's arcsinh is
-    a scalar loop, ten times slower at fleet sizes; within 3e-7 of it."""
-    a = np.abs(x)
-    y = np.multiply(a, a)
-    y += 1.0
-    np.sqrt(y, out=y)
-    y += a
-    np.log(y, out=y)
-    np.copysign(y, x, out=x)
-
-
-def _std(mean_square: np.ndarray, mean: np.ndarray) -> np.ndarray:
-    """Population std as the windowed encoder has it: ``sqrt(max(var, 1e-12))``."""
-    return np.sqrt(np.maximum(mean_square - np.square(mean), 1e-12))
+        views, last = self.views(np.asarray(slots, np.int64))
+        self.clock.mark("views")
+        outputs = self.head_session.run(None, {"views": views, "z_last": last})
+        self.clock.mark("head (ONNX)")
+        return outputs
 
 
 class WindowedEngine(_Engine):
@@ -247,6 +205,7 @@ class WindowedEngine(_Engine):
         self.ring[slots, h + self.window] = x
         self.head[slots] = (h + 1) % self.window
         self.count[slots] = np.minimum(self.count[slots] + 1, self.window)
+        self.clock.mark("rings, sums")
 
     def windows(self, slots: np.ndarray) -> np.ndarray:
         """``[B, W, 12, F]``, oldest first."""
@@ -254,7 +213,11 @@ class WindowedEngine(_Engine):
         return self.ring[slots[:, None], idx]
 
     def infer(self, slots: np.ndarray) -> list[np.ndarray]:
-        return self.session.run(None, {"x": self.windows(slots)})
+        windows = self.windows(slots)
+        self.clock.mark("views")
+        outputs = self.session.run(None, {"x": windows})
+        self.clock.mark("head (ONNX)")
+        return outputs
 
 
 assert NUM_STATISTICS == 7, "IncrementalEngine.infer fills in the seven window statistics"

@@ -215,6 +215,18 @@ def test_cyclonedds_uri_is_merged_after_the_project_s_settings(tmp_path, monkeyp
     assert trace.is_file() and "127.0.0.1" in trace.read_text()
 
 
+def test_a_nonsense_diagnosis_rate_is_refused_in_one_line(deployed, capsys):
+    from robohealth_mj.monitor import main
+
+    with pytest.raises(SystemExit) as exit_:
+        main([f"model={deployed['structural_onnx']}", "source=ros2", "ros2.interface=127.0.0.1",
+              f"ros2.domain_id={next(_DOMAINS)}", "ros2.health_diagnosis_hz=0"])  # fmt: skip
+    assert exit_.value.code == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "monitor: error: ros2.health_diagnosis_hz must be > 0, got 0.0"
+    ]
+
+
 def test_a_fleet_is_split_by_namespace_hash_with_every_arm_in_one_share():
     arms = [f"arm{k}" for k in range(40)]
     shares = [[a for a in arms if in_partition(a, f"{k}/3")] for k in range(3)]

@@ -69,6 +69,85 @@ def test_incremental_inference_equals_windowed_inference(deployed):
         assert np.nanmax(np.abs(a - b)) <= TOLERANCE
 
 
+def _window_max_by_scan(engine, slots: np.ndarray) -> np.ndarray:
+    """The definition the block maxima must meet: the maximum over the window's W records,
+    the oldest counted with its ``g_first`` and no step, the others as recorded:
+    ``[B, N, G + 3S]`` (g, |step|, signal, -signal)."""
+    g, f0 = engine.g, engine.first
+    out = []
+    for slot in slots.tolist():
+        order = (engine.head[slot] + np.arange(engine.window)) % engine.window  # oldest first
+        raw = engine.raw[order, slot].copy()
+        raw[0, :, :g], raw[0, :, g:] = engine.g_fixed[slot], 0.0
+        signal = engine.z[order, slot][..., f0:]
+        out.append(np.concatenate([raw, signal, -signal], axis=-1).max(axis=0))
+    return np.stack(out)
+
+
+def test_block_window_maxima_equal_a_scan_of_the_window(deployed):
+    """The fleet keeps window maxima by blocks (three records a tick); through gaps (windows
+    restarting at any block phase) and ticks that skip streams, the views they give (max of g;
+    asinh of min, max and max |step| of each signal) equal those of a full scan."""
+    rec = load_recordings([deployed["heldout"]])
+    fleet = FleetRuntime(deployed["structural_onnx"], chunk=4)
+    engine, streams = fleet.engine, 11
+    g, s = engine.g, engine.s
+    slots = fleet.register([f"s{k}" for k in range(streams)])
+    rng = np.random.default_rng(3)
+    index, checked = np.zeros(streams, np.int64), 0
+    for _ in range(6 * fleet.window):
+        send = rng.random(streams) < 0.85  # the others skip this tick: a gap, a restart
+        index[~send] += 1
+        who = np.flatnonzero(send)
+        r = fleet.step(slots[who], index[who], 0.05 * (index[who] + 1), rec.x[index[who] + 5 * who])
+        index[who] += 1
+        full = slots[who][r.status == DECIDED]
+        if not len(full):
+            continue
+        views = engine.views(full)[0]
+        peak = _window_max_by_scan(engine, full)
+        stats = views[..., 3 * g : 3 * g + 7 * s].reshape(len(full), -1, s, 7)
+        np.testing.assert_array_equal(views[..., 2 * g : 3 * g], peak[..., :g])
+        for column, expected in ((2, -peak[..., g + 2 * s :]), (3, peak[..., g + s : g + 2 * s]),
+                                 (6, peak[..., g : g + s])):  # fmt: skip
+            np.testing.assert_allclose(
+                stats[..., column], np.arcsinh(expected), rtol=1e-6, atol=5e-7
+            )
+        checked += len(full)
+    assert checked > 100
+
+
+def _decisions(fleet: FleetRuntime, x: np.ndarray, streams: int, ticks: int) -> dict:
+    """Every row's status, top class, top joint and alarm over a replay with a gap per stream."""
+    slots = fleet.register([f"s{k}" for k in range(streams)])
+    out: dict[str, list] = {k: [] for k in ("status", "cls", "joint", "alarm", "probs")}
+    for t in range(ticks):
+        send = np.arange(streams) != t % 23  # stream t % 23 skips this tick (when there is one)
+        r = fleet.step(slots[send], np.full(send.sum(), t), np.full(send.sum(), 0.05 * (t + 1)),
+                       x[37 * np.flatnonzero(send) + t])  # fmt: skip
+        out["status"].append(r.status)
+        out["cls"].append(r.probs.argmax(1))
+        out["joint"].append(r.joint_scores.argmax(1))
+        out["alarm"].append(np.stack([r.alarm, r.alarm_class, r.alarm_joint], axis=1))
+        out["probs"].append(r.probs)
+    return {k: np.concatenate(v) for k, v in out.items()}
+
+
+def test_parts_and_threads_do_not_change_a_decision(deployed):
+    """The tick split in parts of a few streams on two threads decides (status, class, joint,
+    alarm) as one call on one thread; the probabilities agree to float32 rounding (onnxruntime
+    rounds a batch of 2 and one of 7 differently)."""
+    rec = load_recordings([deployed["heldout"]])
+    one = _decisions(FleetRuntime(deployed["structural_onnx"], chunk=10_000), rec.x, 7, 80)
+    parts = FleetRuntime(deployed["structural_onnx"], chunk=2, shards=2)
+    split = _decisions(parts, rec.x, 7, 80)
+    parts.close()
+    assert (one["status"] == DECIDED).sum() > 300 and (one["alarm"][:, 0] > 0).any()
+    for key in ("status", "cls", "joint", "alarm"):
+        np.testing.assert_array_equal(one[key], split[key])
+    np.testing.assert_allclose(one["probs"], split["probs"], atol=1e-6)
+
+
 def test_models_without_an_incremental_form_fall_back_to_windows():
     assert supports_incremental(fresh_variant("anomaly_residual", 8))
     assert not supports_incremental(fresh_variant("anomaly_residual", 8, "backbone=thesis"))
