@@ -5,3 +5,5 @@ set -euo pipefail
 PY=${PY:-.venv/bin/python}
 $PY -m robohealth_mj.bench ros2 --model results/faint_faults/anomaly_residual_w32_seed42.onnx \
   --data outputs/corpus/quick/heldout_seed900 --arms 10 25 50 75 --seconds 15 | tee results/ros2/bench_ros2.txt
+# The deployment-speed issue before/after (fast decoding, diagnoses as bytes, scale-out):
+# results/fleet/speed/command.sh writes its live figures to results/ros2/speed/.

@@ -3,10 +3,12 @@
 # worktree) and after it (this checkout), on one machine, one after the other, nothing else
 # running (2 cores; the benchmarks time 50 ms ticks and DDS latency). About 45 min.
 #   BEFORE=4ecece7 bash results/fleet/speed/command.sh
+# Outputs: results/fleet/speed (the fleet step, decisions), results/ros2/speed (live over DDS).
 set -euo pipefail
 PY=$(realpath "${PY:-.venv/bin/python}")
 BEFORE=${BEFORE:-4ecece7}
 OUT=results/fleet/speed
+LIVE=results/ros2/speed  # the live path's outputs
 M=$(realpath results/headline_physics/anomaly_residual_w32_seed42.onnx)
 D=outputs/bench_replay/heldout_seed900
 # a 15-minute held-out-seed session to replay (any recording serves: only its values' spread matters)
@@ -27,16 +29,16 @@ run_before streams --model $M --data $D --streams 2000 --seconds 60 --memory-rou
 run_after streams --model $M --data $D --streams 2000 --seconds 60 --memory-rounds 1 > $OUT/streams_after.txt
 run_after streams --model $M --data $D --profile 1000 2000 4000 > $OUT/profile_after.txt
 # live over DDS: per-sensor and aggregated layouts; then /health_diagnosis at 1 Hz; then two monitors
-run_before ros2 --model $M --data $D --arms 25 50 --layouts per_sensor > $OUT/ros2_before.txt
-run_before ros2 --model $M --data $D --arms 50 100 --layouts aggregated | tail -n +2 >> $OUT/ros2_before.txt
-run_after ros2 --model $M --data $D --arms 25 35 50 100 --layouts per_sensor > $OUT/ros2_after.txt
-run_after ros2 --model $M --data $D --arms 50 100 150 200 --layouts aggregated | tail -n +2 >> $OUT/ros2_after.txt
-run_after ros2 --model $M --data $D --arms 50 100 --layouts per_sensor --monitors 2 > $OUT/ros2_after_scaleout.txt
+run_before ros2 --model $M --data $D --arms 25 50 --layouts per_sensor > $LIVE/ros2_before.txt
+run_before ros2 --model $M --data $D --arms 50 100 --layouts aggregated | tail -n +2 >> $LIVE/ros2_before.txt
+run_after ros2 --model $M --data $D --arms 25 35 50 100 --layouts per_sensor > $LIVE/ros2_after.txt
+run_after ros2 --model $M --data $D --arms 50 100 150 200 --layouts aggregated | tail -n +2 >> $LIVE/ros2_after.txt
+run_after ros2 --model $M --data $D --arms 50 100 --layouts per_sensor --monitors 2 > $LIVE/ros2_after_scaleout.txt
 # /health_diagnosis at 1 Hz (measured before the diagnoses were written as bytes; at 1 Hz they
 # cost 0.02 cores either way)
-run_after ros2 --model $M --data $D --arms 50 100 --layouts per_sensor --health-hz 1 > $OUT/ros2_after_health1.txt
-run_after ros2 --model $M --data $D --arms 35 --layouts per_sensor --health-hz 1 >> $OUT/ros2_after_health1.txt
+run_after ros2 --model $M --data $D --arms 50 100 --layouts per_sensor --health-hz 1 > $LIVE/ros2_after_health1.txt
+run_after ros2 --model $M --data $D --arms 35 --layouts per_sensor --health-hz 1 >> $LIVE/ros2_after_health1.txt
 run_after ros2 --model $M --data $D --arms 100 150 200 --layouts aggregated --health-hz 1 \
-  | tail -n +2 >> $OUT/ros2_after_health1.txt
+  | tail -n +2 >> $LIVE/ros2_after_health1.txt
 run_after ros2 --model $M --data $D --arms 50 100 --layouts per_sensor --monitors 2 --health-hz 1 \
-  > $OUT/ros2_after_scaleout_health1.txt
+  > $LIVE/ros2_after_scaleout_health1.txt
