@@ -228,21 +228,25 @@ def encode_diagnostic_array(stamp_ns: int, frame_id: str, statuses: list[tuple])
     return w.done()
 
 
-def take(reader: Any, kind: type, limit: int) -> tuple[list[Any], list[str]]:
-    """Up to ``limit`` messages from a DDS reader, decoded by :func:`decode`, and why any could
-    not be decoded (one line each; the caller marks the arm). Instance-state notices (no data:
-    a writer went away) are skipped."""
+def take_raw(reader: Any, limit: int) -> list[bytes]:
+    """Up to ``limit`` serialised messages from a DDS reader (the DDS take alone); instance-state
+    notices (no data: a writer went away) are skipped."""
     from cyclonedds._clayer import ddspy_take
     from cyclonedds.core import DDSException, InstanceState, SampleState, ViewState
 
     got = ddspy_take(reader._ref, SampleState.Any | ViewState.Any | InstanceState.Any, limit)
     if isinstance(got, int):
         raise DDSException(got, f"Occurred while taking data in {reader!r}")
+    return [data for data, info in got if info.valid_data]
+
+
+def decode_all(kind: type, taken: list[bytes]) -> tuple[list[Any], list[str]]:
+    """The messages of :func:`take_raw`, decoded by :func:`decode`, and why any could not be
+    (one line each; the caller marks the arm)."""
     messages, problems = [], []
-    for data, info in got:
-        if info.valid_data:
-            try:
-                messages.append(decode(kind, data))
-            except Exception as exc:  # a buffer no decoder reads is that arm's bad input
-                problems.append(f"undecodable {kind.__name__} ({type(exc).__name__}: {exc})")
+    for data in taken:
+        try:
+            messages.append(decode(kind, data))
+        except Exception as exc:  # a buffer no decoder reads is that arm's bad input
+            problems.append(f"undecodable {kind.__name__} ({type(exc).__name__}: {exc})")
     return messages, problems

@@ -12,7 +12,7 @@ pytest.importorskip("cyclonedds", reason="the ROS 2 bridge needs cyclonedds: pip
 
 from robohealth_mj.bags.messages import MessageFactory
 from robohealth_mj.bags.topics import BagTopics
-from robohealth_mj.ros2.cdr import DECODERS, decode, encode_diagnostic_array
+from robohealth_mj.ros2.cdr import DECODERS, decode, decode_all, encode_diagnostic_array
 from robohealth_mj.ros2.idl import (
     DiagnosticArray,
     DiagnosticStatus,
@@ -122,3 +122,11 @@ def test_diagnoses_encoded_as_bytes_equal_the_binding_s_serialisation():
         assert encode_diagnostic_array(stamp, "", status) == data.ljust(
             -(-len(data) // 4) * 4, b"\0"
         )
+
+
+def test_a_buffer_no_decoder_reads_is_a_problem_line_and_the_others_decode():
+    good = JointState(name=["a"], position=[1.0], velocity=[2.0], effort=[3.0])
+    data = good.serialize()
+    messages, problems = decode_all(JointState, [data, data[:9], data])
+    assert messages == [good, good]
+    assert len(problems) == 1 and problems[0].startswith("undecodable JointState (")

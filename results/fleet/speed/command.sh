@@ -42,3 +42,5 @@ run_after ros2 --model $M --data $D --arms 100 150 200 --layouts aggregated --he
   | tail -n +2 >> $LIVE/ros2_after_health1.txt
 run_after ros2 --model $M --data $D --arms 50 100 --layouts per_sensor --monitors 2 --health-hz 1 \
   > $LIVE/ros2_after_scaleout_health1.txt
+# the take and the decoding timed apart (after the runs above)
+run_after ros2 --model $M --data $D --arms 25 35 --layouts per_sensor > $LIVE/ros2_after_phases.txt
