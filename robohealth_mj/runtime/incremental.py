@@ -124,14 +124,17 @@ class IncrementalEngine(_Engine):
         """Run both kernels on no stream: numba compiles them now (or loads its cache), not
         inside the first tick."""
         none, nodes, f = np.zeros(0, np.int64), self.z.shape[2], self.z.shape[3]
-        snapshot = np.zeros((0, nodes, f), np.float32)
         g = np.zeros((0, nodes, self.g), np.float32)
-        kernels.push_snapshots(
-            none, snapshot, g, g, np.zeros(0, np.float32), self.z, self.raw, self.suffix,
-            self.prefix, self.g_fixed, self.sum_z, self.sq_z, self.sum_g, self.sq_g, self.sum_d,
-            self.head, self.count, self.phase, self.first,
-        )  # fmt: skip
+        self._push_state(none, np.zeros((0, nodes, f), np.float32), g, g, np.zeros(0, np.float32))
         self.views(none)
+
+    def _push_state(self, slots, z_new, g_new, g_first, has_prev) -> None:
+        """The push kernel on this engine's state (see :func:`kernels.push_snapshots`)."""
+        kernels.push_snapshots(
+            slots, z_new, g_new, g_first, has_prev, self.z, self.raw, self.suffix, self.prefix,
+            self.g_fixed, self.sum_z, self.sq_z, self.sum_g, self.sq_g, self.sum_d, self.head,
+            self.count, self.phase, self.first,
+        )  # fmt: skip
 
     def ensure(self, capacity: int) -> None:
         old = self.capacity
@@ -160,11 +163,7 @@ class IncrementalEngine(_Engine):
             {"x_new": x, "z_prev": z_prev, "z_first": z_first, "has_prev": has_prev},
         )
         self.clock.mark("encode (ONNX)")
-        kernels.push_snapshots(
-            slots, z_new, g_new, g_first, has_prev, self.z, self.raw, self.suffix, self.prefix,
-            self.g_fixed, self.sum_z, self.sq_z, self.sum_g, self.sq_g, self.sum_d, self.head,
-            self.count, self.phase, self.first,
-        )  # fmt: skip
+        self._push_state(slots, z_new, g_new, g_first, has_prev)
         self.clock.mark("rings, sums")
 
     def views(self, slots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
