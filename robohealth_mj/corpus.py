@@ -26,11 +26,12 @@ import os
 from pathlib import Path
 
 import hydra
+from hydra.utils import instantiate
 from omegaconf import DictConfig
 
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.resources import HYDRA_CONF
-from robohealth_mj.recording.corpus import CORPUS_INDEX, build_corpus
+from robohealth_mj.recording.corpus import CORPUS_INDEX
 
 
 @hydra.main(config_path=HYDRA_CONF, config_name="corpus", version_base="1.3")
@@ -39,10 +40,12 @@ def main(cfg: DictConfig) -> None:
     jobs = cfg.jobs or os.cpu_count() or 1
     extra = [f"faults.fault_model={cfg.fault_model}", *cfg.record_overrides]
     with one_line_errors("corpus"):
-        index = build_corpus(cfg.corpus, out_dir, jobs, extra, cfg.progress)
-    for role, sessions in index["roles"].items():
-        total = sum(s["samples"] for s in sessions)
-        print(f"{role:<20} {len(sessions):>3} session(s) {total:>9} samples")
+        build = instantiate(cfg.corpus.builder)  # sessions (build_corpus) or lives (build_lives)
+        index = build(cfg.corpus, out_dir, jobs, extra, cfg.progress)
+    unit = "life" if index.get("kind") == "lives" else "session"
+    for role, entries in index["roles"].items():
+        total = sum(s["samples"] for s in entries)
+        print(f"{role:<20} {len(entries):>3} {unit}(s) {total:>9} samples")
     print(f"corpus index: {out_dir / CORPUS_INDEX}")
 
 

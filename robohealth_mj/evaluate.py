@@ -1,7 +1,9 @@
 """``python -m robohealth_mj.evaluate ckpt=… data=…``: score a checkpoint on whole recordings.
 
 ``data`` is a file, a session directory or a glob (quote it); ``out`` is the output prefix
-(default: ``eval_<data name>`` next to the checkpoint). Writes JSON and CSV atomically.
+(default: ``eval_<data name>`` next to the checkpoint); ``labels`` how a window is labelled
+(``last``, ``majority``, ``time_weighted``; default: as the model was trained). Writes JSON and CSV
+atomically.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ def main(cfg: DictConfig) -> None:
     if not cfg.ckpt or not cfg.data:
         raise SystemExit("usage: python -m robohealth_mj.evaluate ckpt=PATH data=PATH [out=PREFIX]")
     with one_line_errors("evaluate"):
-        result = evaluate_checkpoint(cfg.ckpt, cfg.data, cfg.device)
+        result = evaluate_checkpoint(cfg.ckpt, cfg.data, cfg.device, cfg.labels)
     prefix = cfg.out or Path(cfg.ckpt).parent / f"eval_{Path(str(cfg.data)).stem}"
     json_path, _ = write_evaluation(result, prefix)
     m = result["metrics"]

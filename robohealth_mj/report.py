@@ -11,6 +11,13 @@ so far, from any machine, not only those still on this one.
 
     python -m robohealth_mj.report outputs/thesis_physics \
         --archive results/thesis_physics/runs --out results/thesis_physics
+
+With ``--lives FILE`` (a ``lives.json`` of ``experiments/lives/campaign.py``) it draws each
+held-out life instead: the wearing joint's true severity, the health index with its band and the
+RUL estimates against the true RUL (``--out``, default the file's directory).
+
+    python -m robohealth_mj.report --lives outputs/lives/gbdt_last_s42/lives.json \
+        --out results/lives
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ from pathlib import Path
 from robohealth_mj.common.errors import InputError, one_line_errors
 from robohealth_mj.reporting.archive import archive_runs
 from robohealth_mj.reporting.build import build_report
+from robohealth_mj.reporting.lives import plot_lives, read_lives
 
 __all__ = ["build_report", "main"]
 
@@ -43,8 +51,13 @@ def main(argv: list[str] | None = None) -> None:
         help="copy the finished runs' records here first, then report on everything archived",
     )
     parser.add_argument("--out", type=Path, help="where the report goes (default: ROOT/report)")
+    parser.add_argument("--lives", type=Path, help="draw the held-out lives of this lives.json")
     args = parser.parse_args(argv)
     with one_line_errors("report"):
+        if args.lives:
+            figs = plot_lives(read_lives(args.lives), args.out or args.lives.parent)
+            print(f"{len(figs)} figures: {figs[0]} (+ one per held-out life)")
+            return
         _report(Path(args.root), args.archive, args.out)
 
 

@@ -198,6 +198,7 @@ LAYERS = (
     ("recording", "twin"),  # simulating sessions; identifying a real arm's twin from its logs
     ("models",),
     ("learn",),
+    ("prognostics",),  # health index and RUL: NumPy only, under the torch-free runtime
     ("runtime",),  # torch-free streaming
     ("deploy", "ros2"),  # offline deployment tools; the live bus
     ("reporting", "benchmarks"),

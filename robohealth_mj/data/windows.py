@@ -1,19 +1,20 @@
 """Windows, the run-aware split and normalisation statistics (thesis §2.4.5-2.4.6).
 
 A window is W consecutive snapshots of one run (never across runs or gaps in sample_index),
-taken every ``stride`` snapshots and labelled by its *final* snapshot.
+taken every ``stride`` snapshots and labelled by its *final* snapshot, or (``labels=majority`` or
+``time_weighted``, :func:`label_windows`) by what its W snapshots show.
 """
 
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import Recording
-from robohealth_mj.schema import feature_index
+from robohealth_mj.schema import N_JOINTS, feature_index
 
 
 @dataclass
@@ -115,3 +116,57 @@ def normalisation(x: np.ndarray, windows: Windows) -> tuple[np.ndarray, np.ndarr
     std = x.std(axis=0)
     std[std < 1e-6] = 1.0  # constant channels (type indicators, zeroed channels) pass through
     return mean.astype(np.float32), std.astype(np.float32)
+
+
+LABEL_RULES = ("last", "majority", "time_weighted")
+
+
+def label_windows(rec: Recording, window: int, rule: str = "last") -> Recording:
+    """``rec`` with each snapshot's label replaced by that of the window of ``window`` snapshots
+    ending there, so that every consumer that labels a window by its final snapshot gets ``rule``.
+
+    - ``last``: the final snapshot's label (``rec`` itself);
+    - ``majority``: the fault (class and joint) most of the window's snapshots carry (a tie goes to
+      the later label); its severity the mean over the snapshots that carry it;
+    - ``time_weighted``: the majority's fault, its severity weighted by the share of the window it
+      covers (a window half inside a 0.6 fault: 0.3).
+
+    A window that lies inside one fault interval keeps its label under every rule; only windows
+    that straddle a change differ. Snapshots that end no whole window keep their own label.
+    """
+    if rule not in LABEL_RULES:
+        raise InputError(f"labels must be one of {list(LABEL_RULES)}, got {rule!r}")
+    if rule == "last" or len(rec) < window:
+        return rec
+    code = rec.fault_class * (N_JOINTS + 1) + (rec.fault_joint + 1)  # one id per (class, joint)
+    codes = np.unique(code)
+
+    def rolling(values: np.ndarray, width: int = window) -> np.ndarray:
+        """``[T]``: the sum of ``values`` over the ``width`` snapshots ending at each t."""
+        c = np.concatenate([[0.0], np.cumsum(values, dtype=np.float64)])
+        out = np.zeros(len(values))
+        out[width - 1 :] = c[width:] - c[:-width]
+        return out
+
+    counts = np.stack([rolling(code == k) for k in codes])  # [K, T]
+    # the latest snapshot's own code wins ties: add a fraction smaller than one count to it
+    counts += 0.5 * (code[None, :] == codes[:, None])
+    best = codes[np.argmax(counts, axis=0)]
+    severity = np.stack([rolling(np.where(code == k, rec.severity, 0.0)) for k in codes])
+    pick = np.searchsorted(codes, best)
+    total = severity[pick, np.arange(len(rec))]
+    carried = np.floor(counts[pick, np.arange(len(rec))])
+    # only a snapshot that ends a whole window of one run, with no gap, gets the window's label
+    joins = np.concatenate([[0.0], (np.diff(rec.run) != 0) | (np.diff(rec.sample_index) != 1)])
+    ends = rolling(joins, window - 1) == 0  # no break between the window's snapshots
+    ends[: window - 1] = False
+    sev = total / (np.maximum(carried, 1.0) if rule == "majority" else window)
+    fault_class = np.where(ends, best // (N_JOINTS + 1), rec.fault_class)
+    fault_joint = np.where(ends, best % (N_JOINTS + 1) - 1, rec.fault_joint)
+    return replace(
+        rec,
+        fault_class=fault_class.astype(rec.fault_class.dtype),
+        fault_joint=fault_joint.astype(rec.fault_joint.dtype),
+        severity=np.where(ends, sev, rec.severity).astype(rec.severity.dtype),
+        active=np.where(ends, fault_class > 0, rec.active),
+    )

@@ -14,7 +14,7 @@ import torch
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
-from robohealth_mj.data.windows import Windows, make_windows, target_joint_moved
+from robohealth_mj.data.windows import Windows, label_windows, make_windows, target_joint_moved
 from robohealth_mj.learn.checkpoint import (
     check_recordings,
     graph_from_checkpoint,
@@ -41,14 +41,19 @@ class Scored:
     predictions: Predictions
 
 
-def score_checkpoint(ckpt_path: Path | str, data: list[str] | str, device: str = "auto") -> Scored:
+def score_checkpoint(
+    ckpt_path: Path | str, data: list[str] | str, device: str = "auto", labels: str | None = None
+) -> Scored:
     """Rebuild the exact model from its checkpoint and predict every window of ``data`` (what
-    evaluation and any per-window measurement share)."""
+    evaluation and any per-window measurement share). Windows are labelled by ``labels``
+    (``last``, ``majority``, ``time_weighted``; default: the rule the model was trained with)."""
     ckpt = load_checkpoint(ckpt_path)
     files = expand_paths(data)
     check_recordings(ckpt, files)
     graph = graph_from_checkpoint(ckpt)
     rec = graph.relabel(load_recordings(files))
+    rule = labels or str(ckpt["config"].get("labels", "last"))
+    rec = label_windows(rec, int(ckpt["window"]), rule)
     dev = pick_device(device)
     tensors = WindowTensors(
         graph.transform(rec.x), rec, ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy(), dev
@@ -59,10 +64,11 @@ def score_checkpoint(ckpt_path: Path | str, data: list[str] | str, device: str =
 
 
 def evaluate_checkpoint(
-    ckpt_path: Path | str, data: list[str] | str, device: str = "auto"
+    ckpt_path: Path | str, data: list[str] | str, device: str = "auto", labels: str | None = None
 ) -> dict[str, Any]:
-    """Rebuild the exact model from its checkpoint and score it on every window of ``data``."""
-    scored = score_checkpoint(ckpt_path, data, device)
+    """Rebuild the exact model from its checkpoint and score it on every window of ``data``
+    (labelled by ``labels``; default: the rule it was trained with)."""
+    scored = score_checkpoint(ckpt_path, data, device, labels)
     ckpt, graph, rec, model = scored.ckpt, scored.graph, scored.rec, scored.model
     files = scored.files
     metrics = metrics_of(scored.predictions, target_joint_moved(rec, scored.windows))
@@ -73,6 +79,7 @@ def evaluate_checkpoint(
         "window": int(ckpt["window"]),
         "data": [str(f) for f in files],
         "data_fingerprint": rec.fingerprint(),
+        "labels": labels or str(ckpt["config"].get("labels", "last")),
         "best_epoch": ckpt["best_epoch"],
         "gamma": gamma_of(model),
         **coupling_report(model, graph),

@@ -26,7 +26,12 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.version import code_version
 from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.data.graphs import GraphSpec, coupling_correlation
-from robohealth_mj.data.windows import make_windows, normalisation, run_aware_split
+from robohealth_mj.data.windows import (
+    label_windows,
+    make_windows,
+    normalisation,
+    run_aware_split,
+)
 from robohealth_mj.learn.checkpoint import save_checkpoint, training_arms
 from robohealth_mj.learn.data import WindowTensors
 from robohealth_mj.learn.loss import loss_from_config
@@ -120,6 +125,7 @@ def prepare(cfg: DictConfig) -> Prepared:
     files = expand_paths(cfg.data.train)
     check_transfer(cfg, files)
     rec = graph.relabel(load_recordings(files))
+    rec = label_windows(rec, int(cfg.window), str(cfg.get("labels", "last")))
     x = graph.transform(rec.x)
     windows = make_windows(rec, int(cfg.window), cfg.stride)
     splits = run_aware_split(rec, windows, int(cfg.seed))
@@ -282,13 +288,14 @@ def fit_trees(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
     started = time.perf_counter()
 
     def table(windows):
-        feats, cls, joint = [], [], []
+        feats, cls, joint, severity = [], [], [], []
         for i in range(0, len(windows), 4096):
             batch = p.tensors.batch(windows, np.arange(i, min(i + 4096, len(windows))))
             feats.append(p.model.features(batch.x))
             cls.append(batch.fault_class.cpu().numpy())
             joint.append(batch.fault_joint.cpu().numpy())
-        return np.concatenate(feats), np.concatenate(cls), np.concatenate(joint)
+            severity.append(batch.severity.cpu().numpy())
+        return tuple(np.concatenate(v) for v in (feats, cls, joint, severity))
 
     record = p.model.fit(
         table(p.splits["train"]),

@@ -5,10 +5,12 @@ splits, checkpoints and metrics: it is an ``nn.Module`` whose boosters live in t
 (their text dumps), so ``state_dict``, ``torch.load(weights_only=True)`` and evaluation work as
 for the networks. It is fitted by :meth:`fit`, not by gradients.
 
-Two boosters: the fault class over all windows, and the faulted joint over faulted windows.
-Features: :func:`window_statistics` of every node, flattened (N * S * 7 columns).
+Boosters: the fault class over all windows, the faulted joint over faulted windows, and (with
+``severity: true``) the severity as a regression over faulted windows: a severity head beside the
+networks'. Features: :func:`window_statistics` of every node, flattened (N * S * 7 columns).
 
-Shapes: ``x [B, W, N, F]`` -> ``class_logits [B, C]``, ``joint_logits [B, J]`` (raw scores).
+Shapes: ``x [B, W, N, F]`` -> ``class_logits [B, C]``, ``joint_logits [B, J]`` (raw scores),
+``severity [B]`` (with a severity booster).
 """
 
 from __future__ import annotations
@@ -58,6 +60,7 @@ class GradientBoostedTrees(nn.Module):
         metric: str = "multi_error",
         first_signal: int = 2,
         channels: list[str] | None = None,
+        severity: bool = False,
         backbone: Any = None,
         max_pool: Any = None,
     ) -> None:
@@ -88,6 +91,8 @@ class GradientBoostedTrees(nn.Module):
         self.rounds, self.early_stopping_rounds = int(rounds), int(early_stopping_rounds)
         self.register_buffer("class_booster", _booster_bytes(None))
         self.register_buffer("joint_booster", _booster_bytes(None))
+        self.register_buffer("severity_booster", _booster_bytes(None))  # empty: no severity head
+        self.fits_severity = bool(severity)
         self._boosters: dict[str, Any] = {}
 
     def features(self, x: torch.Tensor) -> np.ndarray:
@@ -105,24 +110,30 @@ class GradientBoostedTrees(nn.Module):
         seed: int,
         threads: int | None = None,
     ) -> dict[str, Any]:
-        """Fit both boosters. ``train``/``val``: (features ``[K, D]``, class ``[K]``, joint
-        ``[K]`` with -1 on healthy windows). Early stopping on the validation split's ``metric``
-        (error rate by default: the log-loss turns up long before accuracy stops improving)."""
+        """Fit the boosters. ``train``/``val``: (features ``[K, D]``, class ``[K]``, joint
+        ``[K]`` with -1 on healthy windows[, severity ``[K]``]). Early stopping on the validation
+        split's ``metric`` (error rate by default: the log-loss turns up long before accuracy stops
+        improving); the severity booster's on its mean absolute error."""
         import lightgbm as lgb
 
         params = {**self.params, "seed": int(seed), "num_threads": int(threads or 0)}
         record: dict[str, Any] = {}
-        for name, num, pick in (
-            ("class", self.num_classes, lambda c, j: np.ones(len(c), bool)),
-            ("joint", self.num_joints, lambda c, j: j >= 0),
-        ):
-            target = 1 if name == "class" else 2
+        heads = [
+            ("class", 1, lambda c, j: np.ones(len(c), bool),
+             {"objective": "multiclass", "num_class": self.num_classes}, self.params["metric"]),
+            ("joint", 2, lambda c, j: j >= 0,
+             {"objective": "multiclass", "num_class": self.num_joints}, self.params["metric"]),
+        ]  # fmt: skip
+        if self.fits_severity and len(train) > 3:
+            heads.append(("severity", 3, lambda c, j: j >= 0,
+                          {"objective": "regression", "metric": "l1"}, "l1"))  # fmt: skip
+        for name, target, pick, objective, metric in heads:
             tr, va = pick(train[1], train[2]), pick(val[1], val[2])
             dtrain = lgb.Dataset(train[0][tr], train[target][tr], free_raw_data=True)
             dval = lgb.Dataset(val[0][va], val[target][va], reference=dtrain)
             evals: dict = {}
             booster = lgb.train(
-                {**params, "objective": "multiclass", "num_class": num},
+                {**params, **objective},
                 dtrain,
                 num_boost_round=self.rounds,
                 valid_sets=[dval],
@@ -136,9 +147,7 @@ class GradientBoostedTrees(nn.Module):
             setattr(self, f"{name}_booster", _booster_bytes(booster))
             record[name] = {
                 "best_iteration": int(booster.best_iteration),
-                f"val_{self.params['metric']}": [
-                    float(v) for v in evals["val"][self.params["metric"]]
-                ],
+                f"val_{metric}": [float(v) for v in evals["val"][metric]],
             }
         return record
 
@@ -151,11 +160,11 @@ class GradientBoostedTrees(nn.Module):
         return self._boosters[name]
 
     def _load_from_state_dict(self, state_dict, prefix, local_metadata, strict, missing, *rest):
-        for name in ("class_booster", "joint_booster"):
+        for name in ("class_booster", "joint_booster", "severity_booster"):
             key = prefix + name
             if key in state_dict:
                 setattr(self, name, state_dict[key].detach().clone().to(torch.uint8))
-            elif strict:
+            elif strict and name != "severity_booster":  # older checkpoints have no severity
                 missing.append(key)
         self._boosters = {}
 
@@ -167,4 +176,8 @@ class GradientBoostedTrees(nn.Module):
             raw = booster.predict(feats, raw_score=True)
             out[key] = torch.from_numpy(np.asarray(raw, np.float32)).to(x.device)
         out["class_logits"] = out["class_logits"] + self.class_offset
+        if self.severity_booster.numel():
+            raw = self._booster("severity").predict(feats)
+            out["severity"] = torch.from_numpy(np.clip(raw, 0.0, 1.0).astype(np.float32))
+            out["severity"] = out["severity"].to(x.device)
         return out

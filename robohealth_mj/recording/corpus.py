@@ -60,7 +60,7 @@ def plan(corpus: DictConfig, extra: list[str]) -> list[SessionSpec]:
             )
         )
     for role, r in c.items():
-        if role in ("name", "seed", "train"):
+        if role in ("name", "seed", "train", "builder"):
             continue
         for seed in r["seeds"] if "seeds" in r else [r["seed"]]:
             specs.append(

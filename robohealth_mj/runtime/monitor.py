@@ -10,6 +10,7 @@ from contextlib import ExitStack
 from datetime import datetime
 from pathlib import Path
 
+import numpy as np
 from omegaconf import DictConfig
 
 from robohealth_mj.bags import is_bag
@@ -19,15 +20,22 @@ from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.read import recording_arm, recording_sensing
 from robohealth_mj.data.sensing import refuse_missing_channels
+from robohealth_mj.prognostics.health import (
+    Calibration,
+    attribution_from_probabilities,
+    session_health,
+)
+from robohealth_mj.prognostics.rul import TrendRul
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import freeze_startup_heap
+from robohealth_mj.runtime.health import HealthTracker, health_fields
 from robohealth_mj.runtime.metadata import read_metadata
 from robohealth_mj.runtime.online_eval import OnlineEvaluator, joint_activity
 from robohealth_mj.runtime.online_report import online_markdown
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 from robohealth_mj.runtime.sources import replay_stream, sim_stream
-from robohealth_mj.schema import GraphSample
+from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, GraphSample
 
 
 def describe(d: HealthDiagnosis) -> str:
@@ -79,6 +87,9 @@ def monitor_stream(
     settle = runtime.window + policy.clear_after + evidence.clearing_ticks
     evaluator = OnlineEvaluator(settle_ticks=settle, arm=runtime.arm) if cfg.evaluate else None
     last, started, t0 = None, time.perf_counter(), None
+    wear = (
+        SessionWear(cfg.stream_id, cfg.health) if cfg.get("health", {}).get("state_dir") else None
+    )
     with ExitStack() as stack:
         bag = stack.enter_context(BagWriter(cfg.bag_out)) if cfg.bag_out else None
         for t, sample, truth in stream:
@@ -96,6 +107,10 @@ def monitor_stream(
                 evaluator.update(truth, d, *activity)
             if not cfg.quiet:
                 last = print_change(cfg.stream_id, t, d, truth, last)
+            if wear is not None:
+                wear.add(d, runtime.fleet.classes, runtime.fleet.joints)
+    if wear is not None:
+        wear.finish()
     if cfg.bag_out:
         print(f"replayed topics and {BagTopics.load().health_diagnosis} -> {cfg.bag_out}")
     if evaluator is None:
@@ -122,6 +137,51 @@ def monitor_stream(
         f"{_num(alarms['joint_latency_s_median'])} s (medians) -> {out}"
     )
     return result
+
+
+class SessionWear:
+    """The session's decided windows, turned into the arm's health index when it ends and added
+    to the arm's history (``health.state_dir``; :mod:`robohealth_mj.runtime.health`)."""
+
+    def __init__(self, stream_id: str, cfg: DictConfig) -> None:
+        if cfg.get("day") is None:
+            raise InputError("health.state_dir needs health.day: this session's operating day")
+        cal = cfg.get("calibration")
+        self.calibration = Calibration.load(cal) if cal else None
+        self.tracker = HealthTracker(
+            Path(cfg.state_dir),
+            TrendRul(threshold=float(cfg.threshold)),
+            lead_days=float(cfg.lead_days),
+            floor=float(cfg.floor),
+        )
+        self.tracker.history(stream_id)  # a broken state file is refused before the session
+        self.stream_id, self.day = stream_id, float(cfg.day)
+        self.probs: list[list[float]] = []
+        self.joints: list[list[float]] = []
+
+    def add(self, d: HealthDiagnosis, classes: list[str], joints: list[str]) -> None:
+        if d.valid and d.fault_class is not None:
+            self.probs.append([d.class_probabilities.get(c, 0.0) for c in FAULT_CLASSES])
+            self.joints.append([d.joint_scores[j] for j in joints])
+
+    def finish(self) -> list:
+        attribution = attribution_from_probabilities(
+            np.array(self.probs).reshape(-1, len(FAULT_CLASSES)),
+            np.array(self.joints).reshape(-1, len(JOINT_NAMES)),
+        )
+        health = session_health(attribution, self.calibration)
+        if health.windows == 0:
+            raise InputError(f"{self.stream_id}: no decided window this session: no health index")
+        joints = self.tracker.update(self.stream_id, self.day, health)
+        fields = dict(health_fields(joints))
+        for j in joints:
+            name = j.joint
+            print(
+                f"health {self.stream_id} day {self.day:g} {name}: {fields[f'health.{name}']} "
+                f"[{fields[f'health.{name}.band']}] RUL {fields[f'rul_days.{name}']} d "
+                f"[{fields[f'rul_days.{name}.band']}]" + ("  WEAR WARNING" if j.warning else "")
+            )
+        return joints
 
 
 def print_change(

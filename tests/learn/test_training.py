@@ -266,8 +266,10 @@ def test_the_gbdt_baseline_trains_saves_reloads_and_evaluates(tiny_corpus, tmp_p
     ckpt = load_checkpoint(tmp_path / "best.ckpt")  # weights_only=True: boosters are bytes
     assert ckpt["state_dict"]["class_booster"].numel() > 0
     assert ckpt["state_dict"]["joint_booster"].numel() > 0
+    assert ckpt["state_dict"]["severity_booster"].numel() > 0  # the severity regressor
     again = evaluate_checkpoint(tmp_path / "best.ckpt", str(tiny_corpus / "heldout"))
     m = results["heldout"]["metrics"]
+    assert again["metrics"]["severity_mae_faulted"] == m["severity_mae_faulted"] < 0.2
     assert again["metrics"]["accuracy"] == m["accuracy"]
     assert again["metrics"]["localisation_accuracy"] == m["localisation_accuracy"]
     rec = load_recordings([tiny_corpus / "heldout" / GRAPHS_FILE])

@@ -380,3 +380,45 @@ def test_a_diagnosis_serialises_to_sorted_json_that_rebuilds_it():
     assert keys == sorted(keys) and text.startswith(
         '{"accumulated_probabilities": {}, "alarm": "raised"'
     )
+
+
+def test_monitor_adds_each_session_to_the_arm_health_history(deployed, tmp_path, capsys):
+    """``health.state_dir``: each monitored session becomes the arm's per-joint health index,
+    kept across runs of the monitor; a worn elbow reads higher than the healthy day before."""
+    state = tmp_path / "health"
+    fault = "faults=fixed,faults.schedule.fault_class=backlash,faults.schedule.joint=elbow"
+    days = {0: "faults=none", 1: f"{fault},faults.schedule.severity=0.9"}
+    for day, faults in days.items():
+        monitor_main(
+            [
+                f"model={deployed['structural_onnx']}",
+                "source=sim",
+                "duration_s=6",
+                f"sim_overrides=[seed=5,{faults}]",
+                "quiet=true",
+                f"health.state_dir={state}",
+                f"health.day={day}",
+            ]
+        )
+    sessions = json.loads((state / "arm1.health.json").read_text())["sessions"]
+    assert [s["day"] for s in sessions] == [0, 1]
+    elbow = schema.JOINT_NAMES.index("elbow")
+    assert sessions[1]["index"][elbow] > sessions[0]["index"][elbow] + 0.2
+    assert sessions[1]["index"][elbow] == max(sessions[1]["index"])
+    printed = capsys.readouterr().out
+    assert "health arm1 day 1 elbow:" in printed and "RUL" in printed
+
+
+def test_monitor_health_without_a_day_is_one_line(deployed, tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        monitor_main(
+            [
+                f"model={deployed['structural_onnx']}",
+                "source=sim",
+                "duration_s=2",
+                f"health.state_dir={tmp_path}",
+            ]
+        )
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "health.day" in err[0]

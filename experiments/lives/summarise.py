@@ -1,0 +1,134 @@
+"""Tables of the lives campaign: ``results/lives/*.md`` from each run's ``lives.json``.
+
+    python experiments/lives/summarise.py outputs/lives/gbdt_last_s42/lives.json [...] \
+        --out results/lives
+
+One row per run for the health index (held-out lives), one per run and estimator for the RUL
+metrics and warnings (per mechanical mode and overall), beside each other.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from robohealth_mj.common.atomic import atomic_write_text
+
+MODES = ("backlash", "friction", "jam", "struct_weaken")
+
+
+def _fmt(v: float | None, digits: int = 3) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "—"
+    return f"{v:.{digits}f}"
+
+
+def _run(r: dict) -> str:
+    return r.get("run", r["variant"])
+
+
+def health_rows(runs: list[dict]) -> list[str]:
+    lines = [
+        "| run | labels | index MAE, all joints | index MAE, wearing joint | band covers truth "
+        "(±0.02) | healthy lives MAE | calibration sessions |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in runs:
+        h, g = r["health"]["heldout_lives"], r["health"]["healthy_lives"]
+        lines.append(
+            f"| {_run(r)} | {r['labels']} | {_fmt(h['index_mae_all_joints'])} | "
+            f"{_fmt(h['index_mae_wearing_joint'])} | {_fmt(h['band_coverage_0.02'])} | "
+            f"{_fmt(g['index_mae_all_joints'])} | {r['calibration_sessions']} |"
+        )
+    return lines
+
+
+def _mean(values: list) -> float:
+    return float(np.mean(values)) if len(values) else math.nan
+
+
+def _summary(rows: list[dict]) -> dict:
+    al = [r["alpha_lambda_0.5"] for r in rows if r["alpha_lambda_0.5"] is not None]
+    ra = [max(r["relative_accuracy_0.5"], -1.0) for r in rows
+          if r["relative_accuracy_0.5"] is not None]  # fmt: skip
+    lead = [r["warning_lead_days"] for r in rows]
+    warned = [v for v in lead if v is not None]
+    stretch = [max(r["failure_day"] - r["onset_day"], 1.0) for r in rows]
+    estimates = max(sum(len(r["days"]) for r in rows), 1)
+    return {
+        "lives": len(rows),
+        "ph_days": _mean([r["prognostic_horizon"] for r in rows]),
+        "ph_fraction": _mean(
+            [r["prognostic_horizon"] / s for r, s in zip(rows, stretch, strict=True)]
+        ),
+        "alpha_lambda": _mean(al),
+        "ra": float(np.median(ra)) if ra else math.nan,
+        "warned_5": _mean([v is not None and v >= 5 for v in lead]),
+        "lead_median": float(np.median(warned)) if warned else math.nan,
+        "wall_ms": 1000 * sum(r["wall_s"] for r in rows) / estimates,
+    }
+
+
+def rul_rows(runs: list[dict]) -> list[str]:
+    lines = [
+        "| run | estimator | mode | lives | prognostic horizon, days (share of onset→failure) "
+        "| alpha-lambda (alpha 0.2, lambda 0.5) | RA at half-life (median) "
+        "| warned ≥ 5 days ahead | lead, median "
+        "days | ms / estimate |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in runs:
+        estimators = sorted({row["estimator"] for row in r["rul"]}, key=lambda e: e != "trend")
+        for est in estimators:
+            mine = [row for row in r["rul"] if row["estimator"] == est]
+            for mode in (*MODES, "all"):
+                rows = mine if mode == "all" else [row for row in mine if row["mode"] == mode]
+                if not rows:
+                    continue
+                s = _summary(rows)
+                lines.append(
+                    f"| {_run(r)} | {est} | {mode} | {s['lives']} | {_fmt(s['ph_days'], 1)} "
+                    f"({_fmt(s['ph_fraction'], 2)}) | {_fmt(s['alpha_lambda'], 2)} | "
+                    f"{_fmt(s['ra'], 2)} | {_fmt(s['warned_5'], 2)} | {_fmt(s['lead_median'], 1)} "
+                    f"| {_fmt(s['wall_ms'], 1)} |"
+                )
+    return lines
+
+
+def warning_rows(runs: list[dict]) -> list[str]:
+    lines = [
+        "| run | lead days | floor | healthy arm-days | days warned | warnings / 100 healthy "
+        "days | wrong-joint warning days |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in runs:
+        w = r["healthy"]
+        lines.append(
+            f"| {_run(r)} | {r['lead_days']:g} | {r['floor']:g} | {w['healthy_arm_days']} | "
+            f"{w['warned_healthy_days']} | {_fmt(w['warnings_per_100_healthy_days'], 2)} | "
+            f"{w['wrong_joint_warning_days']} |"
+        )
+    return lines
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("runs", nargs="+", type=Path)
+    ap.add_argument("--out", type=Path, default=Path("results/lives"))
+    args = ap.parse_args()
+    runs = [json.loads(p.read_text()) for p in args.runs]
+    text = "\n".join([
+        "## Health index on held-out lives", "", *health_rows(runs), "",
+        "## RUL on held-out lives (wearing joint)", "", *rul_rows(runs), "",
+        "## Wear warnings on healthy arm-days", "", *warning_rows(runs), "",
+    ])  # fmt: skip
+    atomic_write_text(args.out / "lives.md", text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()

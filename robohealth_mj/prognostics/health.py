@@ -1,0 +1,141 @@
+"""A health index per joint and session, from the windows a model scored in that session.
+
+Each window says how likely a mechanical fault is (class probabilities), where (joint
+probabilities) and how bad (the severity head). The session's raw index of joint j is the mean
+over its windows of ``P(mechanical fault) * P(joint j) * severity``: the severity the model
+attributes to j per window of running. Windows in which the joint barely moves show no evidence and
+pull the mean down; a monotone calibration fitted on training lives (:class:`Calibration`) maps the
+raw index to the severity scale. Its interval comes from a block bootstrap over the session's
+windows (neighbouring windows overlap, so whole blocks are resampled).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.schema import FAULT_CLASSES
+
+MECHANICAL_CLASSES = ("backlash", "friction", "jam", "struct_weaken")
+
+
+def _softmax(logits: np.ndarray) -> np.ndarray:
+    z = logits - logits.max(axis=1, keepdims=True)
+    e = np.exp(z)
+    return e / e.sum(axis=1, keepdims=True)
+
+
+def window_attribution(
+    class_logits: np.ndarray, joint_logits: np.ndarray, severity: np.ndarray | None
+) -> np.ndarray:
+    """``[K, J]``: per window, the severity attributed to each joint (``class_logits [K, C]``,
+    ``joint_logits [K, J]``, ``severity [K]`` or None for a model without a severity head)."""
+    return attribution_from_probabilities(
+        _softmax(np.asarray(class_logits, np.float64)),
+        _softmax(np.asarray(joint_logits, np.float64)),
+        severity,
+    )
+
+
+def attribution_from_probabilities(
+    p_class: np.ndarray, p_joint: np.ndarray, severity: np.ndarray | None = None
+) -> np.ndarray:
+    """:func:`window_attribution` from probabilities (``[K, C]`` over ``FAULT_CLASSES``,
+    ``[K, J]``), as the runtime's diagnoses carry them."""
+    mech = [FAULT_CLASSES.index(c) for c in MECHANICAL_CLASSES]
+    p_mech = np.asarray(p_class, np.float64)[:, mech].sum(axis=1)
+    sev = np.ones(len(p_mech)) if severity is None else np.clip(np.asarray(severity), 0.0, 1.0)
+    return (p_mech * sev)[:, None] * np.asarray(p_joint, np.float64)
+
+
+@dataclass
+class Calibration:
+    """A monotone map from the raw index to severity: knots ``x`` (raw) and ``y`` (severity),
+    interpolated linearly and held flat beyond the ends. Identity when nothing was fitted."""
+
+    x: list[float]
+    y: list[float]
+
+    @classmethod
+    def identity(cls) -> Calibration:
+        return cls([0.0, 1.0], [0.0, 1.0])
+
+    @classmethod
+    def load(cls, path: str | Path) -> Calibration:
+        """A calibration saved as JSON ``{"x": [...], "y": [...]}``."""
+        try:
+            data = json.loads(Path(path).read_text())
+            cal = cls([float(v) for v in data["x"]], [float(v) for v in data["y"]])
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise InputError(f"{path}: not a health calibration ({exc})") from None
+        if len(cal.x) != len(cal.y) or len(cal.x) < 2 or np.any(np.diff(cal.x) <= 0):
+            raise InputError(f"{path}: a calibration needs >= 2 increasing x with one y each")
+        return cal
+
+    @classmethod
+    def fit(cls, raw: np.ndarray, truth: np.ndarray, knots: int = 12) -> Calibration:
+        """Isotonic regression of ``truth`` on ``raw`` (pool-adjacent-violators), thinned to at
+        most ``knots`` points at the raw index's quantiles."""
+        order = np.argsort(raw, kind="stable")
+        xs, ys = np.asarray(raw, float)[order], np.asarray(truth, float)[order]
+        level, weight, start = [], [], []
+        for i, value in enumerate(ys):  # pool adjacent violators
+            level.append(value)
+            weight.append(1.0)
+            start.append(i)
+            while len(level) > 1 and level[-2] > level[-1]:
+                w = weight[-2] + weight[-1]
+                level[-2] = (level[-2] * weight[-2] + level[-1] * weight[-1]) / w
+                weight[-2] = w
+                level.pop(), weight.pop(), start.pop()
+        fitted = np.repeat(level, np.asarray(weight, int))
+        picks = np.unique(np.linspace(0, len(xs) - 1, knots).round().astype(int))
+        kx, ky = xs[picks], fitted[picks]
+        keep = np.concatenate([[True], np.diff(kx) > 0])
+        return cls(kx[keep].round(6).tolist(), np.clip(ky[keep], 0.0, 1.0).round(6).tolist())
+
+    def __call__(self, raw: np.ndarray | float) -> np.ndarray:
+        return np.interp(raw, self.x, self.y)
+
+
+@dataclass
+class SessionHealth:
+    """One session's index per joint with its interval (each ``[J]``)."""
+
+    index: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    raw: np.ndarray
+    windows: int
+
+
+def session_health(
+    attribution: np.ndarray,
+    calibration: Calibration | None = None,
+    blocks: int = 20,
+    draws: int = 200,
+    coverage: float = 0.9,
+    seed: int = 0,
+) -> SessionHealth:
+    """The session's index from its windows' ``attribution [K, J]`` (:func:`window_attribution`),
+    with a ``coverage`` interval from a block bootstrap (``blocks`` contiguous blocks, resampled
+    ``draws`` times with ``seed``)."""
+    cal = calibration or Calibration.identity()
+    a = np.asarray(attribution, float)
+    if len(a) == 0:
+        nan = np.full(a.shape[1] if a.ndim == 2 else 6, np.nan)
+        return SessionHealth(nan, nan, nan, nan, 0)
+    raw = a.mean(axis=0)
+    parts = np.array_split(np.arange(len(a)), min(blocks, len(a)))
+    means = np.stack([a[p].mean(axis=0) for p in parts])  # [B, J]
+    sizes = np.array([len(p) for p in parts], float)
+    rng = np.random.default_rng(seed)
+    pick = rng.integers(0, len(parts), size=(draws, len(parts)))
+    boot = (means[pick] * sizes[pick][..., None]).sum(axis=1) / sizes[pick].sum(axis=1)[:, None]
+    tail = (1.0 - coverage) / 2
+    low, high = np.quantile(boot, [tail, 1 - tail], axis=0)
+    return SessionHealth(cal(raw), cal(low), cal(high), raw, len(a))

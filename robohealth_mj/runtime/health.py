@@ -1,0 +1,121 @@
+"""Health across sessions: each arm's per-joint index history, its RUL and the wear warning,
+persisted per arm so that a restarted monitor carries on where it stopped.
+
+A session ends -> :meth:`HealthTracker.update` with the session's :class:`SessionHealth` and its
+operating day -> the history grows, the state file is rewritten atomically, and the joints' RUL
+estimates and warnings come back (and as ``/diagnostics`` key/values, :func:`health_fields`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.prognostics.health import SessionHealth
+from robohealth_mj.prognostics.rul import RulEstimate, TrendRul
+from robohealth_mj.schema import JOINT_NAMES
+
+STATE_VERSION = 1
+
+
+@dataclass
+class JointHealth:
+    joint: str
+    index: float
+    low: float
+    high: float
+    rul: RulEstimate
+    warning: bool
+
+
+@dataclass
+class HealthTracker:
+    """Per-arm health histories under ``state_dir`` (one JSON file per arm)."""
+
+    state_dir: Path
+    estimator: TrendRul = field(default_factory=TrendRul)
+    lead_days: float = 10.0
+    floor: float = 0.15
+
+    def _path(self, arm: str) -> Path:
+        if not arm or any(c in arm for c in "/\\") or arm.startswith("."):
+            raise InputError(f"arm name {arm!r} cannot name a health state file")
+        return Path(self.state_dir) / f"{arm}.health.json"
+
+    def history(self, arm: str) -> dict[str, Any]:
+        """The arm's stored history (empty when none)."""
+        path = self._path(arm)
+        if not path.is_file():
+            return {"version": STATE_VERSION, "arm": arm, "sessions": []}
+        try:
+            state = json.loads(path.read_text())
+        except ValueError as exc:
+            raise InputError(f"{path}: not a health state file ({exc})") from None
+        if state.get("version") != STATE_VERSION or not isinstance(state.get("sessions"), list):
+            raise InputError(f"{path}: not a health state file of version {STATE_VERSION}")
+        return state
+
+    def update(self, arm: str, day: float, health: SessionHealth) -> list[JointHealth]:
+        """Add one session's index (at operating ``day``) and return every joint's estimate."""
+        state = self.history(arm)
+        last = state["sessions"][-1]["day"] if state["sessions"] else None
+        if last is not None and day <= last:
+            raise InputError(f"{arm}: session day {day} is not after the last one ({last})")
+        state["sessions"].append(
+            {
+                "day": float(day),
+                "index": np.round(health.index, 6).tolist(),
+                "low": np.round(health.low, 6).tolist(),
+                "high": np.round(health.high, 6).tolist(),
+                "windows": int(health.windows),
+            }
+        )
+        atomic_write_json(self._path(arm), state)
+        return self.assess(state)
+
+    def assess(self, state: dict[str, Any]) -> list[JointHealth]:
+        sessions = state["sessions"]
+        if not sessions:
+            return []
+        days = np.array([s["day"] for s in sessions])
+        index = np.array([s["index"] for s in sessions], float)  # [S, J]
+        out = []
+        for j, name in enumerate(JOINT_NAMES):
+            rul = self.estimator.estimate(days, index[:, j])
+            last = sessions[-1]
+            out.append(
+                JointHealth(
+                    name,
+                    last["index"][j],
+                    last["low"][j],
+                    last["high"][j],
+                    rul,
+                    rul.warns(self.lead_days, self.floor),
+                )
+            )
+        return out
+
+
+def health_fields(joints: list[JointHealth]) -> list[tuple[str, str]]:
+    """``/diagnostics`` key/values: each joint's index with its band, RUL days and warning."""
+
+    def days(v: float) -> str:
+        return "inf" if not math.isfinite(v) else f"{v:.1f}"
+
+    fields = []
+    for h in joints:
+        fields += [
+            (f"health.{h.joint}", f"{h.index:.3f}"),
+            (f"health.{h.joint}.band", f"{h.low:.3f}..{h.high:.3f}"),
+            (f"rul_days.{h.joint}", days(h.rul.rul)),
+            (f"rul_days.{h.joint}.band", f"{days(h.rul.low)}..{days(h.rul.high)}"),
+            (f"wear_warning.{h.joint}", "true" if h.warning else "false"),
+        ]
+    return fields
