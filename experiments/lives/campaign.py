@@ -54,7 +54,7 @@ def train(
         f"seed={seed}",
         "window=32",
         f"labels={labels}",
-        f"data.train=[{CORPUS}/{TRAIN}_*/day_*]",
+        f"data.train=[{','.join(extra)}]",
         "data.evaluate=null",
         f"out_dir={run_dir / 'model'}",
         "trainer.progress=false",

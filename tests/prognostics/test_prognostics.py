@@ -31,6 +31,10 @@ def test_a_flat_or_noisy_healthy_index_gives_no_rul_and_no_warning():
     assert math.isinf(flat.rul) and not flat.rising
     noisy = 0.03 + rng.normal(0, 0.02, 30)
     assert first_warning(TrendRul(), days, noisy, lead_days=10, floor=0.15) is None
+    # high but not rising (a joint read with an offset): its early bound is near, yet no warning
+    offset = 0.77 + 0.02 * (-1.0) ** days
+    assert any(TrendRul().estimate(days[:k], offset[:k]).low <= 10 for k in range(3, 31))
+    assert first_warning(TrendRul(), days, offset, lead_days=10, floor=0.15) is None
 
 
 def test_the_warning_comes_when_the_early_bound_falls_under_the_lead_time():

@@ -265,3 +265,33 @@ def test_mean_pm_std_is_the_tables_cell_over_the_finite_values():
     assert mean_pm_std([0.8312, 0.8401, 0.8233]) == "0.832 ± 0.007"
     assert mean_pm_std([0.5, None, float("nan"), 0.7], digits=2) == "0.60 ± 0.10"
     assert mean_pm_std([]) == "—"
+
+
+def _life_row(name: str, estimator: str, warn: float | None) -> dict:
+    days = list(range(10))
+    return {
+        "life": name, "mode": "friction", "path": "linear", "joint": "elbow",
+        "estimator": estimator, "failure_day": 10.0, "onset_day": 1.0, "days": days,
+        "truth": [0.08 * d for d in days], "index": [0.08 * d + 0.01 for d in days],
+        "index_low": [0.08 * d for d in days], "index_high": [0.08 * d + 0.02 for d in days],
+        "rul": [None, None, *[10.0 - d for d in days[2:]]], "first_warning_day": warn,
+    }  # fmt: skip
+
+
+def test_report_draws_each_held_out_life_and_refuses_a_file_that_is_none(tmp_path, capsys):
+    from robohealth_mj.report import main
+
+    lives = {"lead_days": 5.0, "rul": [_life_row("a", "trend", 5.0), _life_row("a", "progpy", None),
+                                       _life_row("b", "trend", None)]}  # fmt: skip
+    path = tmp_path / "lives.json"
+    path.write_text(json.dumps(lives))
+    main(["--lives", str(path), "--out", str(tmp_path / "figs")])
+    drawn = sorted(p.name for p in (tmp_path / "figs").glob("*.png"))
+    assert drawn == ["heldout_lives.png", "life_a.png", "life_b.png"]
+    assert all(p.stat().st_size > 10_000 for p in (tmp_path / "figs").glob("*.png"))
+    (tmp_path / "other.json").write_text(json.dumps({"runs": []}))
+    with pytest.raises(SystemExit) as exc:
+        main(["--lives", str(tmp_path / "other.json")])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "other.json" in err[0] and "not a lives result" in err[0]
