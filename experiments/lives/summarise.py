@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj.common.atomic import atomic_write_text
+from robohealth_mj.reporting.markdown import heading
 
 MODES = ("backlash", "friction", "jam", "struct_weaken")
 
@@ -31,19 +32,21 @@ def _run(r: dict) -> str:
     return r.get("run", r["variant"])
 
 
+def _row(cells: list) -> str:
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
 def health_rows(runs: list[dict]) -> list[str]:
-    lines = [
-        "| run | labels | index MAE, all joints | index MAE, wearing joint | band covers truth "
-        "(±0.02) | healthy lives MAE | calibration sessions |",
-        "|---|---|---|---|---|---|---|",
-    ]
+    head = ["run", "labels", "index MAE, all joints", "index MAE, wearing joint",
+            "band covers truth (±0.02)", "healthy lives MAE", "calibration sessions"]  # fmt: skip
+    lines = heading("Health index on held-out lives", head)
     for r in runs:
         h, g = r["health"]["heldout_lives"], r["health"]["healthy_lives"]
-        lines.append(
-            f"| {_run(r)} | {r['labels']} | {_fmt(h['index_mae_all_joints'])} | "
-            f"{_fmt(h['index_mae_wearing_joint'])} | {_fmt(h['band_coverage_0.02'])} | "
-            f"{_fmt(g['index_mae_all_joints'])} | {r['calibration_sessions']} |"
-        )
+        lines.append(_row([
+            _run(r), r["labels"], _fmt(h["index_mae_all_joints"]),
+            _fmt(h["index_mae_wearing_joint"]), _fmt(h["band_coverage_0.02"]),
+            _fmt(g["index_mae_all_joints"]), r["calibration_sessions"],
+        ]))  # fmt: skip
     return lines
 
 
@@ -74,13 +77,11 @@ def _summary(rows: list[dict]) -> dict:
 
 
 def rul_rows(runs: list[dict]) -> list[str]:
-    lines = [
-        "| run | estimator | mode | lives | prognostic horizon, days (share of onset→failure) "
-        "| alpha-lambda (alpha 0.2, lambda 0.5) | RA at half-life (median) "
-        "| warned ≥ 5 days ahead | lead, median "
-        "days | ms / estimate |",
-        "|---|---|---|---|---|---|---|---|---|---|",
-    ]
+    head = ["run", "estimator", "mode", "lives",
+            "prognostic horizon, days (share of onset→failure)",
+            "alpha-lambda (alpha 0.2, lambda 0.5)", "RA at half-life (median)",
+            "warned ≥ 5 days ahead", "lead, median days", "ms / estimate"]  # fmt: skip
+    lines = heading("RUL on held-out lives (wearing joint)", head)
     for r in runs:
         estimators = sorted({row["estimator"] for row in r["rul"]}, key=lambda e: e != "trend")
         for est in estimators:
@@ -90,28 +91,26 @@ def rul_rows(runs: list[dict]) -> list[str]:
                 if not rows:
                     continue
                 s = _summary(rows)
-                lines.append(
-                    f"| {_run(r)} | {est} | {mode} | {s['lives']} | {_fmt(s['ph_days'], 1)} "
-                    f"({_fmt(s['ph_fraction'], 2)}) | {_fmt(s['alpha_lambda'], 2)} | "
-                    f"{_fmt(s['ra'], 2)} | {_fmt(s['warned_5'], 2)} | {_fmt(s['lead_median'], 1)} "
-                    f"| {_fmt(s['wall_ms'], 1)} |"
-                )
+                lines.append(_row([
+                    _run(r), est, mode, s["lives"],
+                    f"{_fmt(s['ph_days'], 1)} ({_fmt(s['ph_fraction'], 2)})",
+                    _fmt(s["alpha_lambda"], 2), _fmt(s["ra"], 2), _fmt(s["warned_5"], 2),
+                    _fmt(s["lead_median"], 1), _fmt(s["wall_ms"], 1),
+                ]))  # fmt: skip
     return lines
 
 
 def warning_rows(runs: list[dict]) -> list[str]:
-    lines = [
-        "| run | lead days | floor | healthy arm-days | days warned | warnings / 100 healthy "
-        "days | wrong-joint warning days |",
-        "|---|---|---|---|---|---|---|",
-    ]
+    head = ["run", "lead days", "floor", "healthy arm-days", "days warned",
+            "warnings / 100 healthy days", "wrong-joint warning days"]  # fmt: skip
+    lines = heading("Wear warnings on healthy arm-days", head)
     for r in runs:
         w = r["healthy"]
-        lines.append(
-            f"| {_run(r)} | {r['lead_days']:g} | {r['floor']:g} | {w['healthy_arm_days']} | "
-            f"{w['warned_healthy_days']} | {_fmt(w['warnings_per_100_healthy_days'], 2)} | "
-            f"{w['wrong_joint_warning_days']} |"
-        )
+        lines.append(_row([
+            _run(r), f"{r['lead_days']:g}", f"{r['floor']:g}", w["healthy_arm_days"],
+            w["warned_healthy_days"], _fmt(w["warnings_per_100_healthy_days"], 2),
+            w["wrong_joint_warning_days"],
+        ]))  # fmt: skip
     return lines
 
 
@@ -121,11 +120,7 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=Path("results/lives"))
     args = ap.parse_args()
     runs = [json.loads(p.read_text()) for p in args.runs]
-    text = "\n".join([
-        "## Health index on held-out lives", "", *health_rows(runs), "",
-        "## RUL on held-out lives (wearing joint)", "", *rul_rows(runs), "",
-        "## Wear warnings on healthy arm-days", "", *warning_rows(runs), "",
-    ])  # fmt: skip
+    text = "\n".join([*health_rows(runs), "", *rul_rows(runs), "", *warning_rows(runs), ""])
     atomic_write_text(args.out / "lives.md", text)
     print(text)
 
