@@ -31,7 +31,7 @@ from omegaconf import DictConfig
 
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.resources import HYDRA_CONF
-from robohealth_mj.recording.corpus import CORPUS_INDEX
+from robohealth_mj.recording.corpus import CORPUS_INDEX, build_corpus
 
 
 @hydra.main(config_path=HYDRA_CONF, config_name="corpus", version_base="1.3")
@@ -40,7 +40,8 @@ def main(cfg: DictConfig) -> None:
     jobs = cfg.jobs or os.cpu_count() or 1
     extra = [f"faults.fault_model={cfg.fault_model}", *cfg.record_overrides]
     with one_line_errors("corpus"):
-        build = instantiate(cfg.corpus.builder)  # sessions (build_corpus) or lives (build_lives)
+        # sessions (build_corpus, also for a corpus config that names no builder) or lives
+        build = instantiate(cfg.corpus.builder) if "builder" in cfg.corpus else build_corpus
         index = build(cfg.corpus, out_dir, jobs, extra, cfg.progress)
     unit = "life" if index.get("kind") == "lives" else "session"
     for role, entries in index["roles"].items():

@@ -92,3 +92,19 @@ def test_a_life_of_an_unknown_mode_is_refused_in_one_line():
     cfg = compose_config("corpus", [*TINY, "corpus.roles.train_lives.modes=[sensor_noise]"])
     with pytest.raises(Exception, match="wear no mechanism"):
         plan_lives(cfg.corpus)
+
+
+def test_the_corpus_command_records_lives_from_the_config_builder(tmp_path):
+    """``python -m robohealth_mj.corpus corpus=lives``: the config's builder records lives."""
+    import subprocess
+    import sys
+
+    args = [a for a in TINY if "train_lives" not in a or "lives=" not in a]
+    one = ["corpus.roles.train_lives.lives=1", "corpus.roles.train_lives.max_days=3"]
+    cmd = [sys.executable, "-m", "robohealth_mj.corpus", *args, *one, f"out_dir={tmp_path}",
+           "progress=false"]  # fmt: skip
+    out = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "train_lives            1 life(s)" in out.stdout
+    index = json.loads((tmp_path / "corpus.json").read_text())
+    assert index["kind"] == "lives" and set(index["roles"]) == {"train_lives", "healthy_lives"}
