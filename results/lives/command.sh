@@ -23,15 +23,17 @@ for run in gbdt_last_s42 stgnn_fixed_last_s42 gbdt_standard+lives_last_s42; do
   cp "outputs/lives/$run/lives.json" "results/lives/lives_$run.json"
   cp "outputs/lives/$run/calibration.json" "results/lives/calibration_$run.json"
 done
-# the severity head on the standard held-out session, windows labelled each way
-$PY -m robohealth_mj.train variant=gbdt seed=42 window=32 labels=last \
-    'data.train=[outputs/corpus/standard/train_*]' \
-    data.evaluate.heldout=outputs/corpus/standard/heldout_seed900 data.evaluate.probe=null \
-    out_dir=outputs/severity_labels/gbdt_last
-for rule in last majority time_weighted; do
-  $PY -m robohealth_mj.evaluate ckpt=outputs/severity_labels/gbdt_last/best.ckpt \
-      data=outputs/corpus/standard/heldout_seed900 labels=$rule \
-      out=outputs/severity_labels/gbdt_last/eval_heldout_as_$rule
+# the severity head on the standard held-out session: trained and scored with each label rule
+for trained in last time_weighted; do
+  $PY -m robohealth_mj.train variant=gbdt seed=42 window=32 labels=$trained \
+      'data.train=[outputs/corpus/standard/train_*]' \
+      data.evaluate.heldout=outputs/corpus/standard/heldout_seed900 data.evaluate.probe=null \
+      out_dir=outputs/severity_labels/gbdt_$trained
+  for rule in last majority time_weighted; do
+    $PY -m robohealth_mj.evaluate ckpt=outputs/severity_labels/gbdt_$trained/best.ckpt \
+        data=outputs/corpus/standard/heldout_seed900 labels=$rule \
+        out=outputs/severity_labels/gbdt_$trained/eval_heldout_as_$rule
+  done
 done
 $PY experiments/lives/severity_strata.py outputs/severity_labels/gbdt_last/best.ckpt \
     outputs/corpus/standard/heldout_seed900 > results/lives/severity_strata_gbdt_standard.json
