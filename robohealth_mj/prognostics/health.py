@@ -18,15 +18,10 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.numeric import softmax
 from robohealth_mj.schema import FAULT_CLASSES
 
 MECHANICAL_CLASSES = ("backlash", "friction", "jam", "struct_weaken")
-
-
-def _softmax(logits: np.ndarray) -> np.ndarray:
-    z = logits - logits.max(axis=1, keepdims=True)
-    e = np.exp(z)
-    return e / e.sum(axis=1, keepdims=True)
 
 
 def window_attribution(
@@ -35,8 +30,8 @@ def window_attribution(
     """``[K, J]``: per window, the severity attributed to each joint (``class_logits [K, C]``,
     ``joint_logits [K, J]``, ``severity [K]`` or None for a model without a severity head)."""
     return attribution_from_probabilities(
-        _softmax(np.asarray(class_logits, np.float64)),
-        _softmax(np.asarray(joint_logits, np.float64)),
+        softmax(np.asarray(class_logits, np.float64)),
+        softmax(np.asarray(joint_logits, np.float64)),
         severity,
     )
 

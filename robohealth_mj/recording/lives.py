@@ -28,7 +28,8 @@ from tqdm import tqdm
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.version import code_version
-from robohealth_mj.data.jsonl import read_jsonl_samples
+from robohealth_mj.data.arrays import load_recordings
+from robohealth_mj.data.relative import to_raw
 from robohealth_mj.faults.catalogue import MECHANICAL
 from robohealth_mj.faults.wear import PATH_KINDS, draw_path, joint_usage, path_record
 from robohealth_mj.recording.corpus import CORPUS_INDEX, SessionSpec, _is_complete, _session_config
@@ -115,14 +116,14 @@ def _day_spec(
 
 
 def session_usage(session_dir: Path, rated_torque: np.ndarray) -> np.ndarray:
-    """Usage per joint ``[J]`` of one recorded day (load-weighted revolutions)."""
-    vel, eff, t = [], [], []
-    for s in read_jsonl_samples(session_dir / GRAPHS_FILE):
-        vel.append(s.x[: len(JOINT_NAMES), feature_index("vel")])
-        eff.append(s.x[: len(JOINT_NAMES), feature_index("effort")])
-        t.append(s.t)
-    tick_s = float(np.median(np.diff(t))) if len(t) > 1 else 0.05
-    return joint_usage(np.array(vel), np.array(eff), rated_torque, tick_s)
+    """Usage per joint ``[J]`` of one recorded day (load-weighted revolutions). Read through the
+    recordings' cache, which training on the lives then finds already built."""
+    rec = load_recordings([session_dir / GRAPHS_FILE])
+    x = to_raw(rec.x, rec.arms[0])[:, : len(JOINT_NAMES)]  # the arm's own readings
+    manifest = json.loads((session_dir / MANIFEST_FILE).read_text())
+    tick_s = 1.0 / float(manifest["rates"]["tick_hz"])
+    return joint_usage(x[..., feature_index("vel")], x[..., feature_index("effort")], rated_torque,
+                       tick_s)  # fmt: skip
 
 
 def _life_id(spec: LifeSpec, corpus: DictConfig, extra: list[str]) -> str:

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.common.numeric import softmax
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
@@ -84,16 +85,11 @@ def freeze_startup_heap() -> None:
     gc.freeze()
 
 
-def _softmax(z: np.ndarray) -> np.ndarray:
-    e = np.exp(z - z.max(axis=-1, keepdims=True))
-    return e / e.sum(axis=-1, keepdims=True)
-
-
 def joint_scores_from_logits(logits: np.ndarray, kind: str) -> np.ndarray:
     """``[B, J]`` joint logits -> scores as the model was trained: ``softmax`` over the joints
     (which joint is at fault) or ``sigmoid`` per joint (is this joint at fault)."""
     if kind == "softmax":
-        return _softmax(logits)
+        return softmax(logits)
     return 0.5 * (1.0 + np.tanh(0.5 * logits))  # sigmoid, no overflow
 
 
@@ -375,7 +371,7 @@ class FleetRuntime:
         ready = gs[full]
         if not len(ready):
             return elapsed
-        probs = _softmax(outputs[0])
+        probs = softmax(outputs[0])
         joint_scores = joint_scores_from_logits(outputs[1], self.joint_scores)
         accumulated = self.evidence.update(ready, probs)
         state, alarm, joint = self.alarms.update(ready, accumulated, joint_scores)

@@ -108,7 +108,7 @@ def monitor_stream(
             if not cfg.quiet:
                 last = print_change(cfg.stream_id, t, d, truth, last)
             if wear is not None:
-                wear.add(d, runtime.fleet.classes, runtime.fleet.joints)
+                wear.add(d, runtime.fleet.joints)
     if wear is not None:
         wear.finish()
     if cfg.bag_out:
@@ -159,7 +159,7 @@ class SessionWear:
         self.probs: list[list[float]] = []
         self.joints: list[list[float]] = []
 
-    def add(self, d: HealthDiagnosis, classes: list[str], joints: list[str]) -> None:
+    def add(self, d: HealthDiagnosis, joints: list[str]) -> None:
         if d.valid and d.fault_class is not None:
             self.probs.append([d.class_probabilities.get(c, 0.0) for c in FAULT_CLASSES])
             self.joints.append([d.joint_scores[j] for j in joints])

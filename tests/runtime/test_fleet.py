@@ -296,10 +296,10 @@ def test_a_tick_exactly_at_the_threshold_votes():
 
 
 def test_softmax_is_stable_for_large_and_far_apart_logits():
-    from robohealth_mj.runtime.fleet import _softmax
+    from robohealth_mj.common.numeric import softmax
 
     z = np.array([[120.0, 100.0, 0.0], [0.0, -1.0, -2.0]], np.float32)
-    p = _softmax(z)
+    p = softmax(z)
     assert np.isfinite(p).all()
     np.testing.assert_allclose(p.sum(axis=1), 1.0, rtol=1e-6)
     e = np.exp(np.array([0.0, -20.0, -120.0]))
