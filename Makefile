@@ -32,11 +32,16 @@ run: setup
 	$(BIN)/python -m robohealth_mj.train -m +experiment=quick
 	$(BIN)/python -m robohealth_mj.report outputs/campaign_quick
 
+# Two pytest workers (pytest-xdist): the suite is one core's work end to end (training,
+# subprocesses), so two halve its wall time; the DDS tests share one worker (tests/ros2/conftest.py)
+# and the trained fixtures are built once for both (tests/conftest.py:cached).
+TEST_WORKERS ?= 2
+
 test: setup
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadgroup
 
 test-fast: setup
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadgroup -m "not slow"
 
 bench: setup
 	$(BIN)/python -m robohealth_mj.bench sim

@@ -10,6 +10,12 @@ from __future__ import annotations
 import os
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # headless rendering; must precede importing mujoco
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    # Spread over workers (`make test`: one per core), each keeps to one thread: torch's and
+    # OpenMP's pools (LightGBM's too) sized to every core would oversubscribe them. Inherited by
+    # the subprocesses the tests start; set before anything imports torch.
+    for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+        os.environ.setdefault(_var, "1")
 
 import json
 from collections.abc import Callable
@@ -90,19 +96,34 @@ def deciding_alarm_args() -> list[str]:
             for k in ("raise_after", "clear_after", "min_confidence")]  # fmt: skip
 
 
+def _shared_root(tmp_path_factory) -> Path | None:
+    """Where fixtures are built once for every process of this run: ``ROBOHEALTH_TEST_CACHE``
+    (kept between runs), or, with ``pytest -n`` (xdist), the temporary directory its workers
+    share; ``None`` in a plain single-process session."""
+    if cache := os.environ.get("ROBOHEALTH_TEST_CACHE"):
+        return Path(cache)
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        return tmp_path_factory.getbasetemp().parent / "shared"
+    return None
+
+
 def cached(tmp_path_factory, name: str, build: Callable[[Path], dict]) -> dict:
-    """``build(root)`` once per session, or once per ``ROBOHEALTH_TEST_CACHE`` directory: its
-    JSON-able result is kept beside what it wrote, and a later session reuses both."""
-    cache = os.environ.get("ROBOHEALTH_TEST_CACHE")
-    if not cache:
+    """``build(root)`` once per run: in a single process, once per session; with xdist workers
+    or a ``ROBOHEALTH_TEST_CACHE`` directory, once under a file lock (the first worker to need it
+    builds, the others wait and read), its JSON-able result kept beside what it wrote."""
+    shared = _shared_root(tmp_path_factory)
+    if shared is None:
         return build(tmp_path_factory.mktemp(name))
-    root = Path(cache) / name
+    from filelock import FileLock
+
+    root = shared / name
     done = root / "fixture.json"
-    if done.is_file():
-        return json.loads(done.read_text())
     root.mkdir(parents=True, exist_ok=True)
-    result = build(root)
-    done.write_text(json.dumps(result))
+    with FileLock(str(shared / f"{name}.lock")):
+        if done.is_file():
+            return json.loads(done.read_text())
+        result = build(root)
+        done.write_text(json.dumps(result))
     return result
 
 
