@@ -311,6 +311,7 @@ def fit_trees(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
         "val_localisation": val_m.get("localisation_accuracy"),
         "val_macro_f1": val_m.get("macro_f1"),
         "val_score": validation_score(val_m),
+        "val_severity_mae_faulted": val_m.get("severity_mae_faulted"),  # None without the head
         "boosting": record,
     }
     for key in ("val_accuracy", "val_localisation", "val_macro_f1", "val_score"):

@@ -22,6 +22,7 @@ import torch
 from torch import nn
 
 from robohealth_mj import schema
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.models.statistics import window_statistics
 
 
@@ -38,6 +39,12 @@ def _booster_from(buffer: torch.Tensor):
     if buffer.numel() == 0:
         return None
     return lgb.Booster(model_str=bytes(buffer.cpu().numpy()).decode())
+
+
+# LightGBM objectives for the severity booster: squared error predicts the conditional mean, which
+# pulls the outer severity levels toward the middle when the windows leave the level uncertain;
+# absolute error predicts the conditional median, which minimises the MAE severity is scored on.
+SEVERITY_OBJECTIVES = ("regression", "regression_l1", "huber")
 
 
 class GradientBoostedTrees(nn.Module):
@@ -61,6 +68,7 @@ class GradientBoostedTrees(nn.Module):
         first_signal: int = 2,
         channels: list[str] | None = None,
         severity: bool = False,
+        severity_objective: str = "regression",
         backbone: Any = None,
         max_pool: Any = None,
     ) -> None:
@@ -74,7 +82,7 @@ class GradientBoostedTrees(nn.Module):
         names = schema.FEATURE_NAMES[first_signal:]
         unknown = sorted(set(channels or ()) - set(names))
         if unknown:
-            raise ValueError(f"model.channels: unknown {unknown}; known: {list(names)}")
+            raise InputError(f"model.channels: unknown {unknown}; known: {list(names)}")
         keep = [first_signal + names.index(c) for c in channels] if channels else None
         self.register_buffer("channel_index", torch.tensor(keep if keep else [], dtype=torch.long))
         self.params = {
@@ -93,6 +101,10 @@ class GradientBoostedTrees(nn.Module):
         self.register_buffer("joint_booster", _booster_bytes(None))
         self.register_buffer("severity_booster", _booster_bytes(None))  # empty: no severity head
         self.fits_severity = bool(severity)
+        if severity_objective not in SEVERITY_OBJECTIVES:
+            known = ", ".join(SEVERITY_OBJECTIVES)
+            raise InputError(f"model.severity_objective: {severity_objective!r}; known: {known}")
+        self.severity_objective = severity_objective
         self._boosters: dict[str, Any] = {}
 
     def features(self, x: torch.Tensor) -> np.ndarray:
@@ -125,8 +137,8 @@ class GradientBoostedTrees(nn.Module):
              {"objective": "multiclass", "num_class": self.num_joints}, self.params["metric"]),
         ]  # fmt: skip
         if self.fits_severity and len(train) > 3:
-            heads.append(("severity", 3, lambda c, j: j >= 0,
-                          {"objective": "regression", "metric": "l1"}, "l1"))  # fmt: skip
+            objective = {"objective": self.severity_objective, "metric": "l1"}
+            heads.append(("severity", 3, lambda c, j: j >= 0, objective, "l1"))
         for name, target, pick, objective, metric in heads:
             tr, va = pick(train[1], train[2]), pick(val[1], val[2])
             dtrain = lgb.Dataset(train[0][tr], train[target][tr], free_raw_data=True)

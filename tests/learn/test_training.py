@@ -292,6 +292,29 @@ def test_gbdt_boosters_are_byte_identical_for_one_seed(tiny_corpus, tmp_path):
     assert boosters[2] != boosters[0]  # the seed reaches the trees (bagging, split order)
 
 
+@pytest.mark.parametrize(
+    "override, needle",
+    [
+        ("model.severity_objective=l3", "train: error: model.severity_objective: 'l3'; known:"),
+        ("model.channels=[torque]", "train: error: model.channels: unknown ['torque']"),
+    ],
+)
+def test_a_bad_gbdt_setting_is_one_line_and_exit_status_2(tiny_corpus, tmp_path, override, needle):
+    """The trees' own settings, refused where the model is built (after the data are read): one
+    line naming the key, exit status 2, no traceback."""
+    import subprocess
+    import sys
+
+    args = [sys.executable, "-m", "robohealth_mj.train", "variant=gbdt", override,
+            f"data.train=[{tiny_corpus}/train_*]", "data.evaluate.heldout=null",
+            "data.evaluate.probe=null", "trainer.progress=false", "window=8",
+            f"out_dir={tmp_path}"]  # fmt: skip
+    proc = subprocess.run(args, capture_output=True, text=True, timeout=300)
+    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+    assert len(lines) == 1 and needle in lines[0], proc.stderr
+
+
 @pytest.mark.parametrize("variant", ["stgnn_fixed", "anomaly_residual"])
 def test_a_short_run_learns_far_above_chance(learnable_corpus, tmp_path, variant):
     """Would fail if the default backbone could not learn: a few epochs on a small corpus must

@@ -212,6 +212,40 @@ def test_gbdt_reads_only_the_channels_it_is_given():
         GradientBoostedTrees(adj, 6, F, 8, channels=["torque"])
 
 
+def test_gbdt_severity_objective_l1_predicts_the_median_level():
+    """Where windows cannot tell two severities apart, squared error predicts their mean (a level
+    no fault has) and absolute error the median level, which is what MAE scores."""
+    from robohealth_mj.models.gbdt import GradientBoostedTrees
+
+    rng = np.random.default_rng(0)
+    n = 600
+    feats = rng.normal(size=(n, 4)).astype(np.float32)
+    group = (feats[:, 0] > 0).astype(int)  # what the windows show: one of two groups
+    cls, joint = 1 + group, group  # every window faulted
+    # group 0: severity 0.3 twice as often as 0.9 (median 0.3, mean 0.5); group 1: always 0.6
+    severity = np.where(group == 1, 0.6, rng.choice([0.3, 0.3, 0.9], size=n)).astype(np.float32)
+    split = n * 2 // 3
+    data = (feats, cls, joint, severity)
+    train = tuple(a[:split] for a in data)
+    val = tuple(a[split:] for a in data)
+    adj = torch.as_tensor(schema.adjacency())
+    # small trees on large leaves: the two groups are all there is to learn
+    kw = {"severity": True, "rounds": 60, "num_leaves": 4, "min_child_samples": 50,
+          "feature_fraction": 1.0}  # fmt: skip
+    predicted = {}
+    for objective in ("regression", "regression_l1"):
+        trees = GradientBoostedTrees(adj, 6, F, 8, severity_objective=objective, **kw)
+        trees.fit(train, val, seed=0, threads=1)
+        predicted[objective] = trees._booster("severity").predict(feats[split:])
+    low = group[split:] == 0
+    assert abs(np.median(predicted["regression"][low]) - 0.5) < 0.08
+    assert abs(np.median(predicted["regression_l1"][low]) - 0.3) < 0.05
+    mae = {k: np.abs(v - severity[split:]).mean() for k, v in predicted.items()}
+    assert mae["regression_l1"] < mae["regression"]
+    with pytest.raises(ValueError, match=r"model\.severity_objective: 'l3'"):
+        GradientBoostedTrees(adj, 6, F, 8, severity_objective="l3")
+
+
 def _head_with(scores: str, coupling: np.ndarray, seed: int = 0):
     """An anomaly head whose coupling is ``coupling`` and whose predictor ``f`` outputs zero, so
     each sensor's residual is its own embedding."""
