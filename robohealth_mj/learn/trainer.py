@@ -148,7 +148,8 @@ def prepare(cfg: DictConfig) -> Prepared:
     return Prepared(cfg, graph, rec, splits, mean, std, tensors, model, device, pool)
 
 
-def _save(p: Prepared, out_dir: Path, best_epoch: int, gamma: float | None) -> None:
+def save_prepared(p: Prepared, out_dir: Path, best_epoch: int, gamma: float | None) -> None:
+    """``p.model`` as ``out_dir/best.ckpt`` with its config, graph, normalisation and split."""
     cfg = p.cfg
     save_checkpoint(
         out_dir / CHECKPOINT,
@@ -275,7 +276,7 @@ def fit_gradient(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
             )
         if improved:
             best_score, best_epoch, stale = row["val_score"], epoch, 0
-            _save(p, out_dir, best_epoch, row.get("gamma"))
+            save_prepared(p, out_dir, best_epoch, row.get("gamma"))
         else:
             stale += 1
             if t.patience is not None and stale >= int(t.patience):
@@ -283,23 +284,25 @@ def fit_gradient(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
     return best_epoch, history
 
 
+def tree_table(p: Prepared, windows) -> tuple[np.ndarray, ...]:
+    """A fitted-in-one-call model's table of ``windows``: (features ``[K, D]``, class ``[K]``,
+    joint ``[K]``, severity ``[K]``), built in batches of 4,096 windows."""
+    feats, cls, joint, severity = [], [], [], []
+    for i in range(0, len(windows), 4096):
+        batch = p.tensors.batch(windows, np.arange(i, min(i + 4096, len(windows))))
+        feats.append(p.model.features(batch.x))
+        cls.append(batch.fault_class.cpu().numpy())
+        joint.append(batch.fault_joint.cpu().numpy())
+        severity.append(batch.severity.cpu().numpy())
+    return tuple(np.concatenate(v) for v in (feats, cls, joint, severity))
+
+
 def fit_trees(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
     """Models fitted in one call (``model.fit``), e.g. the gradient-boosted trees."""
     started = time.perf_counter()
-
-    def table(windows):
-        feats, cls, joint, severity = [], [], [], []
-        for i in range(0, len(windows), 4096):
-            batch = p.tensors.batch(windows, np.arange(i, min(i + 4096, len(windows))))
-            feats.append(p.model.features(batch.x))
-            cls.append(batch.fault_class.cpu().numpy())
-            joint.append(batch.fault_joint.cpu().numpy())
-            severity.append(batch.severity.cpu().numpy())
-        return tuple(np.concatenate(v) for v in (feats, cls, joint, severity))
-
     record = p.model.fit(
-        table(p.splits["train"]),
-        table(p.splits["val"]),
+        tree_table(p, p.splits["train"]),
+        tree_table(p, p.splits["val"]),
         seed=int(p.cfg.seed),
         threads=p.cfg.trainer.get("threads"),
     )
@@ -322,7 +325,7 @@ def fit_trees(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
             f"rounds  val acc {row['val_accuracy']:.3f}  loc {row['val_localisation']:.3f}  "
             f"({row['seconds']:.0f} s)"
         )
-    _save(p, out_dir, 1, None)
+    save_prepared(p, out_dir, 1, None)
     return 1, [row]
 
 

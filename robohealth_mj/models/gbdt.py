@@ -44,7 +44,7 @@ def _booster_from(buffer: torch.Tensor):
 # LightGBM objectives for the severity booster: squared error predicts the conditional mean, which
 # pulls the outer severity levels toward the middle when the windows leave the level uncertain;
 # absolute error predicts the conditional median, which minimises the MAE severity is scored on.
-SEVERITY_OBJECTIVES = ("regression", "regression_l1", "huber")
+SEVERITY_OBJECTIVES = ("regression", "regression_l1")
 
 
 class GradientBoostedTrees(nn.Module):
@@ -121,11 +121,15 @@ class GradientBoostedTrees(nn.Module):
         val: tuple[np.ndarray, np.ndarray, np.ndarray],
         seed: int,
         threads: int | None = None,
+        only: tuple[str, ...] | None = None,
     ) -> dict[str, Any]:
         """Fit the boosters. ``train``/``val``: (features ``[K, D]``, class ``[K]``, joint
         ``[K]`` with -1 on healthy windows[, severity ``[K]``]). Early stopping on the validation
         split's ``metric`` (error rate by default: the log-loss turns up long before accuracy stops
-        improving); the severity booster's on its mean absolute error."""
+        improving); the severity booster's on its mean absolute error. ``only``: fit just these
+        heads (``class``, ``joint``, ``severity``), keeping the others as they are; each head's
+        trees depend on its own objective, data and seed alone, so a refit head equals a fresh
+        one."""
         import lightgbm as lgb
 
         params = {**self.params, "seed": int(seed), "num_threads": int(threads or 0)}
@@ -139,6 +143,7 @@ class GradientBoostedTrees(nn.Module):
         if self.fits_severity and len(train) > 3:
             objective = {"objective": self.severity_objective, "metric": "l1"}
             heads.append(("severity", 3, lambda c, j: j >= 0, objective, "l1"))
+        heads = [head for head in heads if only is None or head[0] in only]
         for name, target, pick, objective, metric in heads:
             tr, va = pick(train[1], train[2]), pick(val[1], val[2])
             dtrain = lgb.Dataset(train[0][tr], train[target][tr], free_raw_data=True)

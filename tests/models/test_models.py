@@ -232,11 +232,19 @@ def test_gbdt_severity_objective_l1_predicts_the_median_level():
     # small trees on large leaves: the two groups are all there is to learn
     kw = {"severity": True, "rounds": 60, "num_leaves": 4, "min_child_samples": 50,
           "feature_fraction": 1.0}  # fmt: skip
-    predicted = {}
+    predicted, fitted = {}, {}
     for objective in ("regression", "regression_l1"):
         trees = GradientBoostedTrees(adj, 6, F, 8, severity_objective=objective, **kw)
         trees.fit(train, val, seed=0, threads=1)
         predicted[objective] = trees._booster("severity").predict(feats[split:])
+        fitted[objective] = trees
+    # refitting one head (experiments/lives/severity_objective.py) keeps the others and equals
+    # a model trained with that objective from the start
+    refit, classes = fitted["regression"], fitted["regression"].class_booster.clone()
+    refit.severity_objective = "regression_l1"
+    refit.fit(train, val, seed=0, threads=1, only=("severity",))
+    assert torch.equal(refit.class_booster, classes)
+    assert torch.equal(refit.severity_booster, fitted["regression_l1"].severity_booster)
     low = group[split:] == 0
     assert abs(np.median(predicted["regression"][low]) - 0.5) < 0.08
     assert abs(np.median(predicted["regression_l1"][low]) - 0.3) < 0.05
