@@ -41,7 +41,13 @@ HELD_OUT, TRAIN, HEALTHY = "heldout_lives", "train_lives", "healthy_lives"
 
 
 def train(
-    variant: str, seed: int, labels: str, run_dir: Path, epochs: int, extra: list[str]
+    variant: str,
+    seed: int,
+    labels: str,
+    run_dir: Path,
+    epochs: int,
+    extra: list[str],
+    overrides: list[str],
 ) -> Path:
     ckpt = run_dir / "model" / CHECKPOINT
     if ckpt.is_file():
@@ -59,6 +65,7 @@ def train(
         f"out_dir={run_dir / 'model'}",
         "trainer.progress=false",
         f"trainer.epochs={epochs}",
+        *overrides,
     ]
     subprocess.run(cmd, check=True)
     return ckpt
@@ -264,12 +271,18 @@ def main() -> None:
     ap.add_argument("--estimators", default="trend,progpy")
     ap.add_argument("--lead-days", type=float, default=None, help="default: tuned on train lives")
     ap.add_argument("--floor", type=float, default=None)
+    ap.add_argument(
+        "--override",
+        action="append",
+        default=[],
+        help="a training config override, repeatable (e.g. model.severity_objective=regression)",
+    )
     args = ap.parse_args()
     index = json.loads((CORPUS / "corpus.json").read_text())
     threshold = float(index["config"]["threshold"])
     run_dir = OUT / (args.name or f"{args.variant}_{args.labels}_s{args.seed}")
     data = [f"{CORPUS}/{TRAIN}_*/day_*", *filter(None, args.train_also.split(","))]
-    ckpt = train(args.variant, args.seed, args.labels, run_dir, args.epochs, data)
+    ckpt = train(args.variant, args.seed, args.labels, run_dir, args.epochs, data, args.override)
     train_s = json.loads((ckpt.parent / "train_summary.json").read_text()).get("wall_seconds")
     scores = score_lives(ckpt, index, run_dir)
     cal, n_cal = calibrate(ckpt, scores)

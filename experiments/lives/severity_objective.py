@@ -4,7 +4,7 @@ stopping on the validation split, as in training), each written as a checkpoint 
 scores on the held-out session. Choose on the printed validation MAE; held-out only to report.
 
     python experiments/lives/severity_objective.py outputs/severity_labels/gbdt_last/best.ckpt \
-        --objectives regression,regression_l1 --out outputs/severity_objective
+        --objectives regression,regression_l1,levels --out outputs/severity_objective
 
 Prints one JSON line per objective: validation MAE on faulted windows, rounds, seconds, and
 whether the refit ``regression`` booster equals the checkpoint's byte for byte (it should: a head's
@@ -30,7 +30,7 @@ from robohealth_mj.learn.trainer import prepare, save_prepared, tree_table
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("ckpt", type=Path, help="a gbdt checkpoint trained with model.severity=true")
-    ap.add_argument("--objectives", default="regression,regression_l1")
+    ap.add_argument("--objectives", default="regression,regression_l1,levels")
     ap.add_argument("--out", type=Path, default=Path("outputs/severity_objective"))
     args = ap.parse_args()
     ckpt = load_checkpoint(args.ckpt)

@@ -10,10 +10,13 @@ $PY -m robohealth_mj.corpus corpus=lives
 $PY -m robohealth_mj.corpus '~corpus.probe_payload_high' '~corpus.probe_unseen_arms' \
     '~corpus.probe_nominal_arms' '~corpus.healthy_unseen_arms' '~corpus.probe_unseen_program' \
     '~corpus.val_unseen_program'
-$PY experiments/lives/campaign.py --variant gbdt --labels last
+# the lives' gbdt figures were measured with the severity booster's squared-error objective, the
+# default until 2026-11-26 (now `levels`, chosen on the standard corpus below; not run on lives)
+SQ=(--override model.severity_objective=regression)
+$PY experiments/lives/campaign.py --variant gbdt --labels last "${SQ[@]}"
 $PY experiments/lives/campaign.py --variant stgnn_fixed --labels last --estimators trend
 $PY experiments/lives/campaign.py --variant gbdt --train-also 'outputs/corpus/standard/train_*' \
-    --name gbdt_standard+lives_last_s42
+    --name gbdt_standard+lives_last_s42 "${SQ[@]}"
 $PY experiments/lives/summarise.py outputs/lives/gbdt_last_s42/lives.json \
     outputs/lives/stgnn_fixed_last_s42/lives.json \
     'outputs/lives/gbdt_standard+lives_last_s42/lives.json' --out results/lives
@@ -26,6 +29,7 @@ done
 # the severity head on the standard held-out session: trained and scored with each label rule
 for trained in last time_weighted; do
   $PY -m robohealth_mj.train variant=gbdt seed=42 window=32 labels=$trained \
+      model.severity_objective=regression \
       'data.train=[outputs/corpus/standard/train_*]' \
       data.evaluate.heldout=outputs/corpus/standard/heldout_seed900 data.evaluate.probe=null \
       out_dir=outputs/severity_labels/gbdt_$trained
@@ -37,3 +41,31 @@ for trained in last time_weighted; do
 done
 $PY experiments/lives/severity_strata.py outputs/severity_labels/gbdt_last/best.ckpt \
     outputs/corpus/standard/heldout_seed900 > results/lives/severity_strata_gbdt_standard.json
+# the severity head's formulation (2026-11-26): candidates on the validation split of the `last`
+# checkpoint; then each objective refit on three seeds' checkpoints (seed 42 above; 43 and 44
+# trained with the default, now `levels`) and scored on the held-out session (~25 min)
+$PY experiments/lives/severity_variants.py outputs/severity_labels/gbdt_last/best.ckpt \
+    > results/lives/severity_objective/variants_s42.jsonl
+for s in 43 44; do
+  $PY -m robohealth_mj.train variant=gbdt seed=$s window=32 labels=last \
+      'data.train=[outputs/corpus/standard/train_*]' \
+      data.evaluate.heldout=outputs/corpus/standard/heldout_seed900 data.evaluate.probe=null \
+      out_dir=outputs/severity_objective/gbdt_levels_s$s
+done
+declare -A CKPT=([42]=outputs/severity_labels/gbdt_last/best.ckpt
+                 [43]=outputs/severity_objective/gbdt_levels_s43/best.ckpt
+                 [44]=outputs/severity_objective/gbdt_levels_s44/best.ckpt)
+for s in 42 43 44; do
+  $PY experiments/lives/severity_objective.py "${CKPT[$s]}" --out outputs/severity_objective/s$s \
+      > outputs/severity_objective/s$s.jsonl
+  cp outputs/severity_objective/s$s.jsonl results/lives/severity_objective/
+  for o in regression regression_l1 levels; do
+    $PY -m robohealth_mj.evaluate ckpt=outputs/severity_objective/s$s/$o/best.ckpt \
+        data=outputs/corpus/standard/heldout_seed900 \
+        out=outputs/severity_objective/s$s/$o/eval_heldout
+  done
+done
+$PY experiments/lives/summarise_severity.py outputs/severity_objective --seeds 42,43,44 \
+    > results/lives/severity_objective/table.md
+$PY experiments/lives/severity_strata.py outputs/severity_objective/s42/levels/best.ckpt \
+    outputs/corpus/standard/heldout_seed900 > results/lives/severity_strata_gbdt_levels_standard.json

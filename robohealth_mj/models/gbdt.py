@@ -1,13 +1,15 @@
 """The ``gbdt`` baseline: gradient-boosted trees (LightGBM) on the window statistics of every node.
 
 It is the bar the graph models are measured against, so it goes through the same commands,
-splits, checkpoints and metrics: it is an ``nn.Module`` whose boosters live in two byte buffers
+splits, checkpoints and metrics: it is an ``nn.Module`` whose boosters live in byte buffers
 (their text dumps), so ``state_dict``, ``torch.load(weights_only=True)`` and evaluation work as
 for the networks. It is fitted by :meth:`fit`, not by gradients.
 
 Boosters: the fault class over all windows, the faulted joint over faulted windows, and (with
-``severity: true``) the severity as a regression over faulted windows: a severity head beside the
-networks'. Features: :func:`window_statistics` of every node, flattened (N * S * 7 columns).
+``severity: true``) a severity head over faulted windows beside the networks': level classifiers
+per (fault class, joint) read through the class and joint posteriors (``severity_objective:
+levels``, :mod:`robohealth_mj.models.severity_levels`), or a regression. Features:
+:func:`window_statistics` of every node, flattened (N * S * 7 columns).
 
 Shapes: ``x [B, W, N, F]`` -> ``class_logits [B, C]``, ``joint_logits [B, J]`` (raw scores),
 ``severity [B]`` (with a severity booster).
@@ -23,28 +25,35 @@ from torch import nn
 
 from robohealth_mj import schema
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.models.severity_levels import SeverityLevels
 from robohealth_mj.models.statistics import window_statistics
 
 
 def _booster_bytes(booster: Any | None) -> torch.Tensor:
+    """A booster (or :class:`SeverityLevels`) as a uint8 buffer, so checkpoints hold it."""
     if booster is None:
         return torch.zeros(0, dtype=torch.uint8)
-    text = booster.model_to_string().encode()
+    text = (
+        booster.to_bytes() if hasattr(booster, "to_bytes") else booster.model_to_string().encode()
+    )
     return torch.frombuffer(bytearray(text), dtype=torch.uint8).clone()
 
 
-def _booster_from(buffer: torch.Tensor):
+def _booster_from(buffer: torch.Tensor, levels: bool = False):
     import lightgbm as lgb
 
     if buffer.numel() == 0:
         return None
-    return lgb.Booster(model_str=bytes(buffer.cpu().numpy()).decode())
+    data = bytes(buffer.cpu().numpy())
+    return SeverityLevels.from_bytes(data) if levels else lgb.Booster(model_str=data.decode())
 
 
-# LightGBM objectives for the severity booster: squared error predicts the conditional mean, which
-# pulls the outer severity levels toward the middle when the windows leave the level uncertain;
-# absolute error predicts the conditional median, which minimises the MAE severity is scored on.
-SEVERITY_OBJECTIVES = ("regression", "regression_l1")
+# The severity head's objectives: squared error predicts the conditional mean, which pulls the
+# outer severity levels toward the middle when the windows leave the level uncertain; absolute
+# error (regression_l1) the conditional median; ``levels`` classifies the level per (fault class,
+# joint) and predicts the median of their mixture under the class and joint posteriors
+# (models/severity_levels.py).
+SEVERITY_OBJECTIVES = ("regression", "regression_l1", "levels")
 
 
 class GradientBoostedTrees(nn.Module):
@@ -68,7 +77,7 @@ class GradientBoostedTrees(nn.Module):
         first_signal: int = 2,
         channels: list[str] | None = None,
         severity: bool = False,
-        severity_objective: str = "regression",
+        severity_objective: str = "regression",  # what checkpoints without the key hold
         backbone: Any = None,
         max_pool: Any = None,
     ) -> None:
@@ -140,10 +149,25 @@ class GradientBoostedTrees(nn.Module):
             ("joint", 2, lambda c, j: j >= 0,
              {"objective": "multiclass", "num_class": self.num_joints}, self.params["metric"]),
         ]  # fmt: skip
-        if self.fits_severity and len(train) > 3:
+        severity = self.fits_severity and len(train) > 3
+        if severity and self.severity_objective != "levels":
             objective = {"objective": self.severity_objective, "metric": "l1"}
             heads.append(("severity", 3, lambda c, j: j >= 0, objective, "l1"))
         heads = [head for head in heads if only is None or head[0] in only]
+        if (
+            severity
+            and self.severity_objective == "levels"
+            and (only is None or "severity" in only)
+        ):
+            tr, va = train[2] >= 0, val[2] >= 0
+            self._boosters["severity"], record["severity"] = SeverityLevels.fit(
+                tuple(a[tr] for a in train[:4]),
+                tuple(a[va] for a in val[:4]),
+                params,
+                self.rounds,
+                self.early_stopping_rounds,
+            )
+            self.severity_booster = _booster_bytes(self._boosters["severity"])
         for name, target, pick, objective, metric in heads:
             tr, va = pick(train[1], train[2]), pick(val[1], val[2])
             dtrain = lgb.Dataset(train[0][tr], train[target][tr], free_raw_data=True)
@@ -170,7 +194,8 @@ class GradientBoostedTrees(nn.Module):
 
     def _booster(self, name: str):
         if name not in self._boosters:
-            booster = _booster_from(getattr(self, f"{name}_booster"))
+            levels = name == "severity" and self.severity_objective == "levels"
+            booster = _booster_from(getattr(self, f"{name}_booster"), levels)
             if booster is None:
                 raise RuntimeError("the gbdt model has not been fitted")
             self._boosters[name] = booster
@@ -194,7 +219,12 @@ class GradientBoostedTrees(nn.Module):
             out[key] = torch.from_numpy(np.asarray(raw, np.float32)).to(x.device)
         out["class_logits"] = out["class_logits"] + self.class_offset
         if self.severity_booster.numel():
-            raw = self._booster("severity").predict(feats)
+            if self.severity_objective == "levels":  # a mixture under the fault's posterior
+                classes = torch.softmax(out["class_logits"].float(), dim=1).cpu().numpy()
+                joints = torch.softmax(out["joint_logits"].float(), dim=1).cpu().numpy()
+                raw = self._booster("severity").predict(feats, classes, joints)
+            else:
+                raw = self._booster("severity").predict(feats)
             out["severity"] = torch.from_numpy(np.clip(raw, 0.0, 1.0).astype(np.float32))
             out["severity"] = out["severity"].to(x.device)
         return out
