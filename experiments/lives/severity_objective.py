@@ -19,12 +19,11 @@ import time
 from pathlib import Path
 
 import torch
-from omegaconf import OmegaConf
 
 from robohealth_mj.learn.checkpoint import load_checkpoint
 from robohealth_mj.learn.metrics import metrics_of
 from robohealth_mj.learn.predict import predict
-from robohealth_mj.learn.trainer import prepare, save_prepared, tree_table
+from robohealth_mj.learn.trainer import prepare_from_checkpoint, save_prepared, tree_table
 
 
 def main() -> None:
@@ -34,10 +33,8 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=Path("outputs/severity_objective"))
     args = ap.parse_args()
     ckpt = load_checkpoint(args.ckpt)
-    cfg = OmegaConf.create(ckpt["config"])
-    cfg.trainer.progress = False
-    p = prepare(cfg)  # the same data, split and normalisation as the checkpoint's training
-    p.model.load_state_dict(ckpt["state_dict"])
+    p = prepare_from_checkpoint(ckpt)  # its data, split, normalisation and boosters
+    cfg = p.cfg
     train, val = tree_table(p, p.splits["train"]), tree_table(p, p.splits["val"])
     for objective in args.objectives.split(","):
         started = time.perf_counter()

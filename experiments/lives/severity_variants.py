@@ -19,10 +19,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-from omegaconf import OmegaConf
 
 from robohealth_mj.learn.checkpoint import load_checkpoint
-from robohealth_mj.learn.trainer import prepare, tree_table
+from robohealth_mj.learn.trainer import prepare_from_checkpoint, tree_table
 from robohealth_mj.models.severity_levels import SeverityLevels, nearest_level, severity_levels
 
 
@@ -46,10 +45,8 @@ def main() -> None:
     ap.add_argument("ckpt", type=Path)
     args = ap.parse_args()
     ckpt = load_checkpoint(args.ckpt)
-    cfg = OmegaConf.create(ckpt["config"])
-    cfg.trainer.progress = False
-    p = prepare(cfg)
-    p.model.load_state_dict(ckpt["state_dict"])
+    p = prepare_from_checkpoint(ckpt)  # its data, split, normalisation and boosters
+    cfg = p.cfg
     tables = [tree_table(p, p.splits[s]) for s in ("train", "val")]
     (x, c, j, s), (xv, cv, jv, sv) = [tuple(a[t[2] >= 0] for a in t) for t in tables]
     params = {**p.model.params, "seed": int(cfg.seed)}

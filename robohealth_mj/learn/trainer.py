@@ -148,6 +148,16 @@ def prepare(cfg: DictConfig) -> Prepared:
     return Prepared(cfg, graph, rec, splits, mean, std, tensors, model, device, pool)
 
 
+def prepare_from_checkpoint(ckpt: dict[str, Any]) -> Prepared:
+    """A checkpoint's training again: the same data, split and normalisation (its config) and its
+    trained weights, for research that refits or probes one part of a model."""
+    cfg = OmegaConf.create(ckpt["config"])
+    cfg.trainer.progress = False
+    p = prepare(cfg)
+    p.model.load_state_dict(ckpt["state_dict"])
+    return p
+
+
 def save_prepared(p: Prepared, out_dir: Path, best_epoch: int, gamma: float | None) -> None:
     """``p.model`` as ``out_dir/best.ckpt`` with its config, graph, normalisation and split."""
     cfg = p.cfg
