@@ -44,6 +44,11 @@ def test_the_median_of_the_mixture_reads_each_fault_s_level_and_survives_a_round
     # told the wrong fault, the head reads the wrong feature: the class posterior is used
     wrong = classes[:, [0, 2, 1]]
     assert np.abs(head.predict(feats, wrong, joints) - severity).mean() > 0.15
+    # one window that fault 1 reads as level 0.3 and fault 2 as 0.9: the median follows the more
+    # probable fault, where an expectation would say a level neither holds (0.54)
+    window, ones = np.zeros((2, 3)), np.ones((2, 1))
+    posterior = np.array([[0.0, 0.6, 0.4], [0.0, 0.4, 0.6]])
+    assert head.predict(window, posterior, ones) == pytest.approx([0.3, 0.9])
     again = SeverityLevels.from_bytes(head.to_bytes())
     np.testing.assert_array_equal(again.predict(feats, classes, joints), predicted)
 
