@@ -13,6 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
+from robohealth_mj.reporting.markdown import heading
+from robohealth_mj.reporting.statistics import mean_pm_std
+
 CLASSES = ("backlash", "friction", "jam", "struct_weaken", "sensor_drift", "sensor_noise")
 
 
@@ -32,16 +35,8 @@ def main() -> None:
             )
             metrics = evaluated.get("metrics", evaluated)
             rows.setdefault(objective, []).append({"seed": seed, "fit": fit, "heldout": metrics})
-    head = "| objective | seeds | val MAE | held-out MAE | " + " | ".join(CLASSES) + " | refit s |"
-    print(head)
-    print("|" + "---|" * (head.count("|") - 1))
-
-    def mean_std(values: list[float]) -> str:
-        return (
-            f"{np.mean(values):.4f} ± {np.std(values):.4f}"
-            if len(values) > 1
-            else f"{values[0]:.4f}"
-        )
+    head = ["objective", "seeds", "val MAE", "held-out MAE", *CLASSES, "refit s"]
+    print("\n".join(heading("Severity MAE on faulted windows, by objective", head)))
 
     for objective, runs in rows.items():
         val = [r["fit"]["val_severity_mae_faulted"] for r in runs]
@@ -51,7 +46,7 @@ def main() -> None:
             for c in CLASSES
         ]
         seconds = np.mean([r["fit"]["seconds"] for r in runs])
-        print(f"| {objective} | {len(runs)} | {mean_std(val)} | **{mean_std(held)}** | "
+        print(f"| {objective} | {len(runs)} | {mean_pm_std(val, 4)} | **{mean_pm_std(held, 4)}** | "
               + " | ".join(per_class) + f" | {seconds:.0f} |")  # fmt: skip
     print()
     for objective, runs in rows.items():

@@ -149,16 +149,15 @@ class GradientBoostedTrees(nn.Module):
             ("joint", 2, lambda c, j: j >= 0,
              {"objective": "multiclass", "num_class": self.num_joints}, self.params["metric"]),
         ]  # fmt: skip
-        severity = self.fits_severity and len(train) > 3
-        if severity and self.severity_objective != "levels":
+        wanted = {"class", "joint", "severity"} if only is None else set(only)
+        if not (self.fits_severity and len(train) > 3):
+            wanted.discard("severity")
+        levels = self.severity_objective == "levels"  # not one booster: models/severity_levels.py
+        if "severity" in wanted and not levels:
             objective = {"objective": self.severity_objective, "metric": "l1"}
             heads.append(("severity", 3, lambda c, j: j >= 0, objective, "l1"))
-        heads = [head for head in heads if only is None or head[0] in only]
-        if (
-            severity
-            and self.severity_objective == "levels"
-            and (only is None or "severity" in only)
-        ):
+        heads = [head for head in heads if head[0] in wanted]
+        if "severity" in wanted and levels:
             tr, va = train[2] >= 0, val[2] >= 0
             self._boosters["severity"], record["severity"] = SeverityLevels.fit(
                 tuple(a[tr] for a in train[:4]),
