@@ -84,7 +84,15 @@ def main(argv: list[str] | None = None) -> None:
         p.add_argument("--seconds", type=float, default=seconds, help="paced run length")
         p.add_argument("--shards", type=int, default=2, help="threads the fleet step uses")
         p.add_argument("--chunk", type=int, default=256, help="streams per model call")
+        p.add_argument(
+            "--providers",
+            type=lambda text: [name for name in text.split(",") if name],
+            default=None,
+            help="comma-separated ONNX Runtime execution providers, first preferred "
+            "(e.g. CUDAExecutionProvider,CPUExecutionProvider); default: onnxruntime's own order",
+        )
     streams.add_argument("--no-search", action="store_true", help="skip the stream-count search")
+    streams.add_argument("--limit", type=int, default=8192, help="largest stream count searched")
     streams.add_argument(
         "--profile",
         type=int,
@@ -104,7 +112,7 @@ def main(argv: list[str] | None = None) -> None:
         "--memory-rounds",
         type=int,
         default=3,
-        help="alternated rounds of the with/without-memory comparison",
+        help="alternated rounds of the with/without-memory comparison (0: skip it)",
     )
     args = parser.parse_args(argv)
     if args.what == "ros2":
@@ -114,8 +122,10 @@ def main(argv: list[str] | None = None) -> None:
                    args.health_hz)  # fmt: skip
     elif args.what in ("streams", "soak"):
         from robohealth_mj.benchmarks.fleet import bench_fleet, bench_soak
+        from robohealth_mj.common.errors import one_line_errors
 
-        (bench_fleet if args.what == "streams" else bench_soak)(args)
+        with one_line_errors("bench"):
+            (bench_fleet if args.what == "streams" else bench_soak)(args)
     elif args.what == "infer" and args.model:
         from robohealth_mj.benchmarks.infer import bench_deployed
 

@@ -10,6 +10,7 @@ import numpy as np
 from robohealth_mj.benchmarks.common import onnx_flops, sgemm_rate
 from robohealth_mj.benchmarks.soak import soak
 from robohealth_mj.benchmarks.streams import TICK_S, search, trial
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import FleetRuntime, freeze_startup_heap
 from robohealth_mj.runtime.phases import PhaseClock
@@ -80,13 +81,14 @@ def bench_profile(args: argparse.Namespace, x: np.ndarray) -> list[dict]:
     for streams in args.profile:
         clock = PhaseClock()
         r = trial(args.model, x, streams, args.profile_ticks, shards=args.shards, clock=clock,
-                  chunk=args.chunk)  # fmt: skip
+                  chunk=args.chunk, providers=args.providers)  # fmt: skip
         per_tick = {k: v / args.profile_ticks * 1e3 for k, v in clock.seconds.items()}
         busy = sum(per_tick.values())
         onnx_s = sum(per_tick.get(k, 0.0) for k in ONNX_PHASES) / 1e3
         rate = flops * streams / onnx_s if onnx_s else float("nan")
         print(
-            f"\n{streams} streams, {args.shards} shard threads, parts of <= {args.chunk}: step "
+            f"\n{streams} streams on {r['provider']}, {args.shards} shard threads, parts of <= "
+            f"{args.chunk}: step "
             f"p50 {r['p50_ms']:.1f} ms, p99 {r['p99_ms']:.1f} ms; thread time {busy:.1f} ms "
             "per tick\n"
             "| phase | thread ms per tick | share |\n|---|---|---|"
@@ -109,25 +111,28 @@ def bench_fleet(args: argparse.Namespace) -> dict:
     cores = os.cpu_count() or 1
     print(
         f"{args.model}; {len(x)} recorded snapshots replayed from random offsets; {cores} cores, "
-        f"{args.shards} shard threads; timed: FleetRuntime.step (validate, buffer, infer, alarms)"
+        f"{args.shards} shard threads; timed: FleetRuntime.step (validate, buffer, infer, alarms); "
+        f"execution providers asked for: {', '.join(args.providers or ['onnxruntime default'])}"
     )
     if args.profile:
         return {"profile": bench_profile(args, x)}
     found = None
     if not args.no_search:
         print("search (unpaced, 100 ticks each after the windows fill):")
-        found, _ = search(args.model, x, 100, shards=args.shards)
+        found, _ = search(args.model, x, 100, shards=args.shards, chunk=args.chunk,
+                          limit=args.limit, providers=args.providers)  # fmt: skip
         print(f"sustained: {found} streams with per-tick p99 <= {TICK_S * 1e3:.0f} ms")
     ticks = round(args.seconds / TICK_S)
-    paced = trial(args.model, x, args.streams, ticks, shards=args.shards, paced=True)
-    windowed = trial(args.model, x, args.streams, 40, incremental=False, shards=args.shards)
+    common = {"shards": args.shards, "chunk": args.chunk, "providers": args.providers}
+    paced = trial(args.model, x, args.streams, ticks, paced=True, **common)
+    windowed = trial(args.model, x, args.streams, 40, incremental=False, **common)
     print(
         "\n| path | streams | p50 ms | p99 ms | max ms | ticks over 50 ms | CPU (of all cores) |\n"
         "|---|---|---|---|---|---|---|"
     )
     print(_row(f"incremental, paced 20 Hz for {args.seconds:g} s", paced))
     print(_row("windowed (same runtime, whole window per tick), 40 ticks", windowed))
-    memory = memory_cost(args, x)
+    memory = memory_cost(args, x) if args.memory_rounds > 0 else None
     return {"sustained_streams": found, "paced": paced, "windowed": windowed, "memory": memory}
 
 
@@ -139,7 +144,8 @@ def memory_cost(args: argparse.Namespace, x) -> dict:
     for _ in range(args.memory_rounds):
         for key, evidence in (("off", None), ("on", policy)):
             runs[key].append(trial(args.model, x, args.streams, 200, shards=args.shards,
-                                   evidence=evidence))  # fmt: skip
+                                   evidence=evidence, chunk=args.chunk,
+                                   providers=args.providers))  # fmt: skip
     p50 = {k: float(np.median([r["p50_ms"] for r in v])) for k, v in runs.items()}
     p99 = {k: float(np.median([r["p99_ms"] for r in v])) for k, v in runs.items()}
     print(
@@ -162,7 +168,7 @@ def bench_soak(args: argparse.Namespace) -> dict:
         max_streams=args.streams,
     )  # fmt: skip
     if fleet.engine is None:
-        raise SystemExit(f"bench soak: {fleet.problem}")
+        raise InputError(f"--model: {fleet.problem}")
     ticks = round(args.seconds / TICK_S)
     freeze_startup_heap()
     report = soak(fleet, x, args.streams, ticks, paced=True).summary()

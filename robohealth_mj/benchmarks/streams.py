@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime, freeze_startup_heap
 from robohealth_mj.runtime.phases import PhaseClock
@@ -89,15 +90,16 @@ def trial(
     evidence: EvidencePolicy | None = None,
     clock: PhaseClock | None = None,
     chunk: int = 256,
+    providers: list[str] | None = None,
 ) -> dict[str, float]:
     """A fresh runtime with ``streams`` streams: fill the windows, then time ``ticks`` ticks
-    (with ``clock``, also where each tick's time went)."""
+    (with ``clock``, also where each tick's time went); ``providers`` as ORT names them."""
     fleet = FleetRuntime(
         model, threads=threads, shards=shards, incremental=incremental, capacity=streams,
-        max_streams=streams, evidence=evidence, chunk=chunk,
+        max_streams=streams, evidence=evidence, chunk=chunk, providers=providers,
     )  # fmt: skip
     if fleet.engine is None:
-        raise ValueError(fleet.problem)
+        raise InputError(f"--model: {fleet.problem}")
     slots = fleet.register([f"arm{k:05d}" for k in range(streams)])
     replay = Replay.of(x, streams)
     freeze_startup_heap()
@@ -108,6 +110,7 @@ def trial(
         return {
             "streams": streams,
             "mode": fleet.mode,
+            "provider": fleet.providers[0],
             **run_ticks(fleet, slots, replay, fleet.window + 2, ticks, paced),
         }
     finally:
@@ -117,7 +120,8 @@ def trial(
 
 def search(
     model: str, x: np.ndarray, ticks: int, budget_ms: float = 50.0, start: int = 250,
-    limit: int = 8192, incremental: bool = True, shards: int = 2,
+    limit: int = 8192, incremental: bool = True, shards: int = 2, chunk: int = 256,
+    providers: list[str] | None = None,
 ) -> tuple[int, list[dict]]:  # fmt: skip
     """Largest stream count whose p99 step time fits the tick (in two of three trials):
     doubling, then bisection to 5 %."""
@@ -127,12 +131,14 @@ def search(
         """Majority of up to three trials (the shared machine has bursts of outside load)."""
         passed = failed = 0
         while passed < 2 and failed < 2:
-            row = trial(model, x, n, ticks, incremental, shards=shards)
+            row = trial(model, x, n, ticks, incremental, shards=shards, chunk=chunk,
+                        providers=providers)  # fmt: skip
             rows.append(row)
             ok = row["p99_ms"] <= budget_ms
             passed, failed = passed + ok, failed + (not ok)
             print(
-                f"  {n:>5} streams: p50 {row['p50_ms']:6.1f} ms  p99 {row['p99_ms']:6.1f} ms"
+                f"  {n:>5} streams on {row['provider']}: p50 {row['p50_ms']:6.1f} ms  "
+                f"p99 {row['p99_ms']:6.1f} ms"
                 f"{'' if ok else '  (over)'}",
                 flush=True,
             )

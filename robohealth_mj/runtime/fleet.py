@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.numeric import softmax
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
@@ -93,6 +94,24 @@ def joint_scores_from_logits(logits: np.ndarray, kind: str) -> np.ndarray:
     return 0.5 * (1.0 + np.tanh(0.5 * logits))  # sigmoid, no overflow
 
 
+PREFERRED_PROVIDERS = ("CUDAExecutionProvider", "CPUExecutionProvider")
+
+
+def execution_providers(asked: Sequence[str] | None, available: Sequence[str]) -> list[str]:
+    """The ONNX Runtime providers to open sessions with: those ``asked`` (first preferred), or
+    CUDA where onnxruntime-gpu finds a GPU and else the CPU. A name this install lacks is an
+    error rather than ORT's silent fall-back to the CPU."""
+    if not asked:
+        return [name for name in PREFERRED_PROVIDERS if name in available]
+    missing = [name for name in asked if name not in available]
+    if missing:
+        raise InputError(
+            f"execution provider {missing[0]!r} is not in this onnxruntime install; "
+            f"available: {', '.join(available)}"
+        )
+    return list(asked)
+
+
 class FleetRuntime:
     """Per-stream windows, bulk validation, one model call per tick, alarms."""
 
@@ -111,6 +130,7 @@ class FleetRuntime:
         idle_ticks: int = 1200,
         shards: int = 1,
         chunk: int = 256,
+        providers: Sequence[str] | None = None,
     ) -> None:
         self.max_streams, self.max_burst = max_streams, max_burst
         self.chunk = max(1, chunk)
@@ -124,7 +144,12 @@ class FleetRuntime:
         self.classes, self.joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
         self.engine: IncrementalEngine | WindowedEngine | None = None
         self.mode = "none"
-        self._load(model_path, threads, incremental, capacity)
+        self.providers: list[str] = []  # the execution providers the sessions run on
+        if providers:  # a wrong name is the caller's mistake, not a broken model
+            import onnxruntime as ort
+
+            providers = execution_providers(providers, ort.get_available_providers())
+        self._load(model_path, threads, incremental, capacity, providers)
         self.alarms = AlarmBank(alarm or AlarmPolicy(), len(self.joints), capacity)
         self.evidence = EvidenceBank(evidence or EvidencePolicy(), len(self.classes), capacity)
         self.last_t = np.full(capacity, -np.inf)
@@ -150,14 +175,17 @@ class FleetRuntime:
 
     # model
 
-    def _load(self, model_path, threads: int, incremental: bool, capacity: int) -> None:
+    def _load(
+        self, model_path, threads: int, incremental: bool, capacity: int,
+        providers: Sequence[str] | None,
+    ) -> None:  # fmt: skip
         if not model_path:
             self.problem = "no model configured"
         elif not Path(model_path).is_file():
             self.problem = f"no model file at {model_path}"
         else:
             try:
-                self._open(Path(model_path), threads, incremental, capacity)
+                self._open(Path(model_path), threads, incremental, capacity, providers)
             except Exception as exc:  # a broken model must not take the monitor down
                 self.engine = None
                 self.problem = f"model {model_path} unusable: {type(exc).__name__}: {exc}"
@@ -168,7 +196,10 @@ class FleetRuntime:
                 self.problem,
             )
 
-    def _open(self, path: Path, threads: int, incremental: bool, capacity: int) -> None:
+    def _open(
+        self, path: Path, threads: int, incremental: bool, capacity: int,
+        providers: Sequence[str] | None,
+    ) -> None:  # fmt: skip
         import onnxruntime as ort
 
         from robohealth_mj.runtime.metadata import read_metadata
@@ -182,10 +213,14 @@ class FleetRuntime:
             )
         options = ort.SessionOptions()
         options.intra_op_num_threads = threads
-        providers = ort.get_available_providers()
+        wanted = execution_providers(providers, ort.get_available_providers())
+        if "CUDAExecutionProvider" in wanted and hasattr(ort, "preload_dlls"):
+            ort.preload_dlls()  # CUDA and cuDNN from the pip-installed nvidia-* packages
 
         def session(model: str | bytes):
-            return ort.InferenceSession(model, options, providers=providers)
+            opened = ort.InferenceSession(model, options, providers=wanted)
+            self.providers = opened.get_providers()
+            return opened
 
         self.window = int(meta["window"])
         self.arm = meta.get("arm", DEFAULT_ARM)  # models exported before arms were data: UR5e

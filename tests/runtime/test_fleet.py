@@ -9,11 +9,19 @@ import pytest
 from robohealth_mj import schema
 from robohealth_mj.benchmarks.common import fresh_variant
 from robohealth_mj.benchmarks.soak import KINDS, soak
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.models.incremental import supports_incremental
 from robohealth_mj.monitor import main as monitor_main
 from robohealth_mj.runtime.alarms import CLEARED, HELD, NONE, RAISED, AlarmBank, AlarmPolicy
-from robohealth_mj.runtime.fleet import BUFFERED, DECIDED, INVALID, WARMING, FleetRuntime
+from robohealth_mj.runtime.fleet import (
+    BUFFERED,
+    DECIDED,
+    INVALID,
+    WARMING,
+    FleetRuntime,
+    execution_providers,
+)
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
 from robohealth_mj.runtime.runtime import HealthDiagnosis
 from robohealth_mj.schema import FaultLabel
@@ -642,3 +650,32 @@ def test_the_export_records_how_joint_scores_were_trained(deployed):
     assert joint_score_kind({"config": {}}) == "softmax"  # the trainer's default
     assert read_metadata(deployed["structural_onnx"])["joint_scores"] == "softmax"
     assert FleetRuntime(deployed["structural_onnx"]).describe()["joint_scores"] == "softmax"
+
+
+def test_execution_providers_prefer_cuda_and_refuse_a_name_the_install_lacks():
+    gpu = ["TensorrtExecutionProvider", "CUDAExecutionProvider", "CPUExecutionProvider"]
+    cpu = ["AzureExecutionProvider", "CPUExecutionProvider"]
+    assert execution_providers(None, gpu) == ["CUDAExecutionProvider", "CPUExecutionProvider"]
+    assert execution_providers(None, cpu) == ["CPUExecutionProvider"]
+    assert execution_providers(["CPUExecutionProvider"], gpu) == ["CPUExecutionProvider"]
+    with pytest.raises(InputError, match="'CUDAExecutionProvider' is not in this onnxruntime"):
+        execution_providers(["CUDAExecutionProvider", "CPUExecutionProvider"], cpu)
+
+
+def test_the_fleet_reports_its_provider_and_refuses_an_unknown_one(deployed):
+    fleet = FleetRuntime(deployed["structural_onnx"])
+    assert fleet.engine is not None and fleet.providers[-1] == "CPUExecutionProvider"
+    with pytest.raises(InputError, match="'NoSuchExecutionProvider'"):
+        FleetRuntime(deployed["structural_onnx"], providers=["NoSuchExecutionProvider"])
+
+
+def test_bench_streams_names_an_unknown_provider_in_one_line(deployed, capsys):
+    from robohealth_mj.bench import main as bench_main
+
+    with pytest.raises(SystemExit) as info:
+        model, data = str(deployed["structural_onnx"]), str(deployed["heldout"])
+        bench_main(["streams", "--model", model, "--data", data, "--providers", "NoSuch"])
+    assert info.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("bench: error: execution provider 'NoSuch' is not in this onnxruntime")
+    assert len(err.splitlines()) == 1
