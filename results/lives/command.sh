@@ -10,19 +10,31 @@ $PY -m robohealth_mj.corpus corpus=lives
 $PY -m robohealth_mj.corpus '~corpus.probe_payload_high' '~corpus.probe_unseen_arms' \
     '~corpus.probe_nominal_arms' '~corpus.healthy_unseen_arms' '~corpus.probe_unseen_program' \
     '~corpus.val_unseen_program'
-# the lives' gbdt figures were measured with the severity booster's squared-error objective, the
-# default until 2026-11-26 (now `levels`, chosen on the standard corpus below; not run on lives)
+# the first lives' gbdt figures were measured with the severity booster's squared-error objective,
+# the default until 2026-11-26 (now `levels`, chosen on the standard corpus below; on lives after)
 SQ=(--override model.severity_objective=regression)
 $PY experiments/lives/campaign.py --variant gbdt --labels last "${SQ[@]}"
 $PY experiments/lives/campaign.py --variant stgnn_fixed --labels last --estimators trend
 $PY experiments/lives/campaign.py --variant gbdt --train-also 'outputs/corpus/standard/train_*' \
     --name gbdt_standard+lives_last_s42 "${SQ[@]}"
+# the severity booster as `levels` (the default since 2026-11-26) on lives: standard + lives on
+# three seeds, and lives alone on seed 42 (~20 min each on 2 cores)
+for s in 42 43 44; do
+  $PY experiments/lives/campaign.py --variant gbdt --seed $s \
+      --train-also 'outputs/corpus/standard/train_*' --name gbdt_standard+lives_levels_s$s
+done
+$PY experiments/lives/campaign.py --variant gbdt --labels last --name gbdt_lives_levels_s42
 $PY experiments/lives/summarise.py outputs/lives/gbdt_last_s42/lives.json \
     outputs/lives/stgnn_fixed_last_s42/lives.json \
-    'outputs/lives/gbdt_standard+lives_last_s42/lives.json' --out results/lives
-$PY -m robohealth_mj.report --lives 'outputs/lives/gbdt_standard+lives_last_s42/lives.json' \
+    'outputs/lives/gbdt_standard+lives_last_s42/lives.json' \
+    outputs/lives/gbdt_lives_levels_s42/lives.json \
+    'outputs/lives/gbdt_standard+lives_levels_s42/lives.json' \
+    'outputs/lives/gbdt_standard+lives_levels_s43/lives.json' \
+    'outputs/lives/gbdt_standard+lives_levels_s44/lives.json' --out results/lives
+$PY -m robohealth_mj.report --lives 'outputs/lives/gbdt_standard+lives_levels_s42/lives.json' \
     --out results/lives/figures
-for run in gbdt_last_s42 stgnn_fixed_last_s42 gbdt_standard+lives_last_s42; do
+for run in gbdt_last_s42 stgnn_fixed_last_s42 gbdt_standard+lives_last_s42 gbdt_lives_levels_s42 \
+    gbdt_standard+lives_levels_s42 gbdt_standard+lives_levels_s43 gbdt_standard+lives_levels_s44; do
   cp "outputs/lives/$run/lives.json" "results/lives/lives_$run.json"
   cp "outputs/lives/$run/calibration.json" "results/lives/calibration_$run.json"
 done
