@@ -31,6 +31,9 @@ $PY experiments/lives/summarise.py outputs/lives/gbdt_last_s42/lives.json \
     'outputs/lives/gbdt_standard+lives_levels_s42/lives.json' \
     'outputs/lives/gbdt_standard+lives_levels_s43/lives.json' \
     'outputs/lives/gbdt_standard+lives_levels_s44/lives.json' --out results/lives
+# the trend's window (sessions in its line), chosen on the training lives' prognostic horizon
+$PY experiments/lives/trend_window.py outputs/lives/gbdt_standard+lives_levels_s4{2,3,4} \
+    > results/lives/trend_window.md
 $PY -m robohealth_mj.report --lives 'outputs/lives/gbdt_standard+lives_levels_s42/lives.json' \
     --out results/lives/figures
 for run in gbdt_last_s42 stgnn_fixed_last_s42 gbdt_standard+lives_last_s42 gbdt_lives_levels_s42 \
