@@ -88,8 +88,8 @@ def main(argv: list[str] | None = None) -> None:
             "--providers",
             type=lambda text: [name for name in text.split(",") if name],
             default=None,
-            help="comma-separated ONNX Runtime execution providers, first preferred "
-            "(e.g. CUDAExecutionProvider,CPUExecutionProvider); default: onnxruntime's own order",
+            help="comma-separated ONNX Runtime execution providers, first preferred (e.g. "
+            "CPUExecutionProvider); default: CUDA where onnxruntime-gpu finds a GPU, else CPU",
         )
     streams.add_argument("--no-search", action="store_true", help="skip the stream-count search")
     streams.add_argument("--limit", type=int, default=8192, help="largest stream count searched")

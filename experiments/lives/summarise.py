@@ -126,9 +126,8 @@ def seed_rows(runs: list[dict]) -> list[str]:
             "warned ≥ 5 days ahead (trend)", "warnings / 100 healthy days",
             "lead days, floor"]  # fmt: skip
     lines = heading("Over seeds (held-out lives)", head)
+    groups = {name: members for name, members in groups.items() if len(members) > 1}
     for name, members in groups.items():
-        if len(members) < 2:
-            continue
         held = [m["health"]["heldout_lives"] for m in members]
         warned = [_summary([row for row in m["rul"] if row["estimator"] == "trend"])["warned_5"]
                   for m in members]  # fmt: skip
@@ -140,7 +139,7 @@ def seed_rows(runs: list[dict]) -> list[str]:
             mean_pm_std([m["healthy"]["warnings_per_100_healthy_days"] for m in members], 2),
             "; ".join(f"{m['lead_days']:g}, {m['floor']:g}" for m in members),
         ]))  # fmt: skip
-    return lines
+    return lines if groups else []
 
 
 def main() -> None:
@@ -151,7 +150,7 @@ def main() -> None:
     runs = [json.loads(p.read_text()) for p in args.runs]
     seeds = seed_rows(runs)
     text = "\n".join([*health_rows(runs), "", *rul_rows(runs), "", *warning_rows(runs), "",
-                      *([*seeds, ""] if len(seeds) > 4 else [])])  # fmt: skip
+                      *([*seeds, ""] if seeds else [])])  # fmt: skip
     atomic_write_text(args.out / "lives.md", text)
     print(text)
 

@@ -109,10 +109,11 @@ def bench_fleet(args: argparse.Namespace) -> dict:
     path at the same count; prints a markdown table."""
     x = _frames(args.data)
     cores = os.cpu_count() or 1
+    asked = ", ".join(args.providers or ["default (CUDA if present, else CPU)"])
     print(
         f"{args.model}; {len(x)} recorded snapshots replayed from random offsets; {cores} cores, "
         f"{args.shards} shard threads; timed: FleetRuntime.step (validate, buffer, infer, alarms); "
-        f"execution providers asked for: {', '.join(args.providers or ['onnxruntime default'])}"
+        f"execution providers asked for: {asked}"
     )
     if args.profile:
         return {"profile": bench_profile(args, x)}
