@@ -8,7 +8,8 @@ session, and the RUL and wear warnings it gives on held-out lives.
 Steps (each skipped when done): train ``--variant`` on every day of the training lives
 (``outputs/lives/<run>/model``); score every day of every life (``health_raw.json``: the raw
 index per joint with its bootstrap band); fit the index's calibration on the days the model's
-validation split holds (never on a held-out life); then per held-out life the index against the
+validation split holds (never on a held-out life); tune the warning's lead time and floor on the
+validation lives (lives the model never trained on); then per held-out life the index against the
 truth, each estimator's RUL day by day on the wearing joint (prognostic horizon, alpha-lambda,
 relative accuracy at half-life) and the first warning; warnings on healthy arm-days.
 ``lives.json`` holds every number; ``experiments/lives/summarise.py`` writes the tables.
@@ -38,6 +39,7 @@ from robohealth_mj.schema import JOINT_NAMES
 CORPUS = Path("outputs/corpus/lives")
 OUT = Path("outputs/lives")
 HELD_OUT, TRAIN, HEALTHY = "heldout_lives", "train_lives", "healthy_lives"
+VAL = "val_lives"  # never trained on: the warning's lead time and floor are tuned here
 
 
 def train(
@@ -76,42 +78,44 @@ def _manifest_run_id(session: Path) -> str:
 
 
 def score_lives(ckpt: Path, index: dict, run_dir: Path) -> dict:
-    """Per life: each day's raw index, band and truth per joint (cached)."""
+    """Per life: each day's raw index, band and truth per joint (cached; a life the cache lacks,
+    such as a role added to the corpus later, is scored and added)."""
     cache = run_dir / "health_raw.json"
-    if cache.is_file():
-        return json.loads(cache.read_text())
-    out = {}
-    for role in (TRAIN, HELD_OUT, HEALTHY):
-        for entry in index["roles"].get(role, []):
-            life = json.loads((CORPUS / entry["life"]).read_text())
-            sessions = [CORPUS / entry["dir"] / d["dir"] for d in life["days"]]
-            scored = score_checkpoint(ckpt, [str(s) for s in sessions], device="cpu")
-            p = scored.predictions
-            attribution = window_attribution(p.class_logits, p.joint_logits, p.severity)
-            run_of = np.asarray(scored.rec.run_ids)[scored.rec.run[scored.windows.end]]
-            days = []
-            for d, session in zip(life["days"], sessions, strict=True):
-                rid = _manifest_run_id(session)
-                h = session_health(attribution[run_of == rid], seed=d["day"])
-                days.append(
-                    {
-                        "day": d["day"],
-                        "run_id": rid,
-                        "truth": [d["severity"][j] for j in JOINT_NAMES],
-                        "raw": h.raw.tolist(),
-                        "low": h.low.tolist(),
-                        "high": h.high.tolist(),
-                    }
-                )
-            out[entry["dir"]] = {
-                "role": role,
-                "mode": entry["mode"],
-                "joint": entry["joint"],
-                "path": entry["path"],
-                "failure_day": life["failure_day"],
-                "days": days,
-            }
-            print(f"scored {entry['dir']}: {len(days)} days", flush=True)
+    out = json.loads(cache.read_text()) if cache.is_file() else {}
+    todo = [(role, entry) for role in (TRAIN, VAL, HELD_OUT, HEALTHY)
+            for entry in index["roles"].get(role, []) if entry["dir"] not in out]  # fmt: skip
+    if not todo:
+        return out
+    for role, entry in todo:
+        life = json.loads((CORPUS / entry["life"]).read_text())
+        sessions = [CORPUS / entry["dir"] / d["dir"] for d in life["days"]]
+        scored = score_checkpoint(ckpt, [str(s) for s in sessions], device="cpu")
+        p = scored.predictions
+        attribution = window_attribution(p.class_logits, p.joint_logits, p.severity)
+        run_of = np.asarray(scored.rec.run_ids)[scored.rec.run[scored.windows.end]]
+        days = []
+        for d, session in zip(life["days"], sessions, strict=True):
+            rid = _manifest_run_id(session)
+            h = session_health(attribution[run_of == rid], seed=d["day"])
+            days.append(
+                {
+                    "day": d["day"],
+                    "run_id": rid,
+                    "truth": [d["severity"][j] for j in JOINT_NAMES],
+                    "raw": h.raw.tolist(),
+                    "low": h.low.tolist(),
+                    "high": h.high.tolist(),
+                }
+            )
+        out[entry["dir"]] = {
+            "role": role,
+            "mode": entry["mode"],
+            "joint": entry["joint"],
+            "path": entry["path"],
+            "failure_day": life["failure_day"],
+            "days": days,
+        }
+        print(f"scored {entry['dir']}: {len(days)} days", flush=True)
     atomic_write_json(cache, out)
     return out
 
@@ -238,14 +242,27 @@ def healthy_warnings(scores: dict, cal: Calibration, est: TrendRul, lead: float,
     }
 
 
+def tuning_role(scores: dict) -> str:
+    """Where the warning is tuned: the validation lives where the corpus has them (the model
+    never trained on them), else the training lives (in-sample, so every setting tends to warn
+    every life in time)."""
+    return VAL if any(v["role"] == VAL for v in scores.values()) else TRAIN
+
+
+def as_held_out(scores: dict, role: str) -> dict:
+    """``scores`` with ``role``'s lives in the held-out role and every other life left out, so
+    that :func:`rul_rows` and :func:`healthy_warnings` read them."""
+    return {k: {**v, "role": HELD_OUT if v["role"] == role else "skip"} for k, v in scores.items()}
+
+
 def tune_warning(scores: dict, cal: Calibration, est: TrendRul) -> dict:
-    """Lead time and floor chosen on the training lives (never the held-out ones): the most
-    lives warned >= 5 days ahead, then the fewest warned healthy days."""
-    train_like = {
-        k: {**v, "role": HELD_OUT if v["role"] == TRAIN else "skip"} for k, v in scores.items()
-    }
+    """Lead time and floor chosen on the validation lives (:func:`tuning_role`; never the
+    held-out ones): the most lives warned >= 5 days ahead, then the fewest warned > 20 days
+    ahead, then the shorter lead."""
+    role = tuning_role(scores)
+    train_like = as_held_out(scores, role)
     best = None
-    for lead in (6.0, 8.0, 10.0, 12.0, 15.0):
+    for lead in (6.0, 8.0, 10.0, 12.0, 15.0, 20.0, 25.0):
         for floor in (0.05, 0.1, 0.15, 0.2, 0.3):
             rows = rul_rows(train_like, cal, {"trend": est}, lead, floor)
             ok = np.mean([(r["warning_lead_days"] or -1) >= 5 for r in rows])
@@ -253,7 +270,7 @@ def tune_warning(scores: dict, cal: Calibration, est: TrendRul) -> dict:
             key = (round(float(ok), 3), -round(float(early), 3), -lead)
             if best is None or key > best[0]:
                 best = (key, lead, floor)
-    return {"lead_days": best[1], "floor": best[2], "train_lives_warned_5_days": best[0][0]}
+    return {"lead_days": best[1], "floor": best[2], "tuned_on": role, "warned_5_days": best[0][0]}
 
 
 def main() -> None:
@@ -269,7 +286,9 @@ def main() -> None:
     )
     ap.add_argument("--name", default=None, help="run name (default: variant_labels_sSEED)")
     ap.add_argument("--estimators", default="trend,progpy")
-    ap.add_argument("--lead-days", type=float, default=None, help="default: tuned on train lives")
+    ap.add_argument(
+        "--lead-days", type=float, default=None, help="default: tuned on the validation lives"
+    )
     ap.add_argument("--floor", type=float, default=None)
     ap.add_argument(
         "--override",
@@ -304,10 +323,12 @@ def main() -> None:
         "train_s": train_s,
         "calibration": vars(cal),
         "calibration_sessions": n_cal,
-        "tuned_on_train_lives": tuned,
+        "warning_tuning": tuned,
         "lead_days": lead,
         "floor": floor,
-        "health": {role: health_table(scores, cal, role) for role in (TRAIN, HELD_OUT, HEALTHY)},
+        "health": {
+            role: health_table(scores, cal, role) for role in (TRAIN, VAL, HELD_OUT, HEALTHY)
+        },
         "rul": rul_rows(scores, cal, estimators, lead, floor),
         "healthy": healthy_warnings(scores, cal, trend, lead, floor),
     }

@@ -1,11 +1,12 @@
-"""The trend estimator's window (sessions in its line), chosen on the training lives.
+"""The trend estimator's window (sessions in its line), chosen on the validation lives.
 
     python experiments/lives/trend_window.py outputs/lives/gbdt_standard+lives_levels_s42 [...]
 
-For each run and window: the lead time and floor tuned on the training lives as the campaign
-tunes them, the training lives' mean prognostic horizon and alpha-lambda accuracy (what chooses:
-every window warns every training life in time), and, for the record only, the held-out lives
-warned at least 5 days ahead and the warnings per 100 healthy arm-days. Scores are the runs'
+For each run and window: the lead time and floor tuned as the campaign tunes them (on the
+validation lives, or the training lives where a corpus has none), those lives' share warned at
+least 5 days ahead and mean prognostic horizon and alpha-lambda accuracy (what chooses), and, for
+the record only, the held-out lives warned at least 5 days ahead and the warnings per 100 healthy
+arm-days. Scores are the runs'
 cached ``health_raw.json``; nothing is retrained.
 """
 
@@ -38,14 +39,15 @@ def main() -> None:
     ap.add_argument("runs", nargs="+", type=Path)
     args = ap.parse_args()
     c = _campaign()
-    head = ["run", "window", "lead days, floor", "train: PH days", "train: alpha-lambda",
-            "held-out warned ≥ 5 d", "held-out: healthy warnings / 100 d"]  # fmt: skip
-    print("\n".join(heading("Trend window, chosen on the training lives", head)))
+    head = ["run", "window", "tuned on", "lead days, floor", "tuning: warned ≥ 5 d",
+            "tuning: PH days", "tuning: alpha-lambda", "held-out warned ≥ 5 d",
+            "held-out: healthy warnings / 100 d"]  # fmt: skip
+    print("\n".join(heading("Trend window, chosen on the validation lives", head)))
     for run in args.runs:
         scores = json.loads((run / "health_raw.json").read_text())
         cal = Calibration(**json.loads((run / "calibration.json").read_text()))
-        train = {k: {**v, "role": c.HELD_OUT if v["role"] == c.TRAIN else "skip"}
-                 for k, v in scores.items()}  # fmt: skip
+        role = c.tuning_role(scores)
+        train = c.as_held_out(scores, role)
         for window in WINDOWS:
             est = TrendRul(threshold=0.8, window=window)
             t = c.tune_warning(scores, cal, est)
@@ -54,8 +56,9 @@ def main() -> None:
             held = c.rul_rows(scores, cal, {"trend": est}, lead, floor)
             healthy = c.healthy_warnings(scores, cal, est, lead, floor)
             warned = np.mean([(r["warning_lead_days"] or -1) >= 5 for r in held])
+            tuned = np.mean([(r["warning_lead_days"] or -1) >= 5 for r in tr])
             cells = [
-                run.name, window, f"{lead:g}, {floor:g}",
+                run.name, window, role, f"{lead:g}, {floor:g}", f"{tuned:.2f}",
                 f"{np.mean([r['prognostic_horizon'] for r in tr]):.1f}",
                 f"{np.mean([r['alpha_lambda_0.5'] for r in tr]):.2f}", f"{warned:.2f}",
                 f"{healthy['warnings_per_100_healthy_days']:.2f}",

@@ -18,7 +18,8 @@ $PY experiments/lives/campaign.py --variant stgnn_fixed --labels last --estimato
 $PY experiments/lives/campaign.py --variant gbdt --train-also 'outputs/corpus/standard/train_*' \
     --name gbdt_standard+lives_last_s42 "${SQ[@]}"
 # the severity booster as `levels` (the default since 2026-11-26) on lives: standard + lives on
-# three seeds, and lives alone on seed 42 (~20 min each on 2 cores)
+# three seeds, and lives alone on seed 42 (~20 min each on 2 cores); the corpus's val_lives (added
+# 2026-11-26, ~4 min) are where these runs tune the warning
 for s in 42 43 44; do
   $PY experiments/lives/campaign.py --variant gbdt --seed $s \
       --train-also 'outputs/corpus/standard/train_*' --name gbdt_standard+lives_levels_s$s
@@ -31,7 +32,7 @@ $PY experiments/lives/summarise.py outputs/lives/gbdt_last_s42/lives.json \
     'outputs/lives/gbdt_standard+lives_levels_s42/lives.json' \
     'outputs/lives/gbdt_standard+lives_levels_s43/lives.json' \
     'outputs/lives/gbdt_standard+lives_levels_s44/lives.json' --out results/lives
-# the trend's window (sessions in its line), chosen on the training lives' prognostic horizon
+# the trend's window (sessions in its line) on the validation lives
 $PY experiments/lives/trend_window.py outputs/lives/gbdt_standard+lives_levels_s4{2,3,4} \
     > results/lives/trend_window.md
 $PY -m robohealth_mj.report --lives 'outputs/lives/gbdt_standard+lives_levels_s42/lives.json' \

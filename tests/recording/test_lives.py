@@ -24,6 +24,7 @@ TINY = [  # two wearing lives of a few 3-second days, one healthy life of two da
     "corpus.roles.healthy_lives.lives=1",
     "corpus.roles.healthy_lives.max_days=2",
     "~corpus.roles.heldout_lives",
+    "~corpus.roles.val_lives",
 ]
 
 
