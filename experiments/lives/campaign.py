@@ -242,6 +242,11 @@ def healthy_warnings(scores: dict, cal: Calibration, est: TrendRul, lead: float,
     }
 
 
+def warned_share(rows: list[dict], days: float = 5.0) -> float:
+    """The share of :func:`rul_rows`' lives first warned at least ``days`` before failure."""
+    return float(np.mean([(r["warning_lead_days"] or -1) >= days for r in rows]))
+
+
 def tuning_role(scores: dict) -> str:
     """Where the warning is tuned: the validation lives where the corpus has them (the model
     never trained on them), else the training lives (in-sample, so every setting tends to warn
@@ -260,12 +265,12 @@ def tune_warning(scores: dict, cal: Calibration, est: TrendRul) -> dict:
     held-out ones): the most lives warned >= 5 days ahead, then the fewest warned > 20 days
     ahead, then the shorter lead."""
     role = tuning_role(scores)
-    train_like = as_held_out(scores, role)
+    tuning = as_held_out(scores, role)
     best = None
     for lead in (6.0, 8.0, 10.0, 12.0, 15.0, 20.0, 25.0):
         for floor in (0.05, 0.1, 0.15, 0.2, 0.3):
-            rows = rul_rows(train_like, cal, {"trend": est}, lead, floor)
-            ok = np.mean([(r["warning_lead_days"] or -1) >= 5 for r in rows])
+            rows = rul_rows(tuning, cal, {"trend": est}, lead, floor)
+            ok = warned_share(rows)
             early = np.mean([(r["warning_lead_days"] or 0) > 20 for r in rows])
             key = (round(float(ok), 3), -round(float(early), 3), -lead)
             if best is None or key > best[0]:

@@ -22,25 +22,25 @@ import numpy as np
 
 from robohealth_mj.learn.checkpoint import load_checkpoint
 from robohealth_mj.learn.trainer import prepare_from_checkpoint, tree_table
-from robohealth_mj.models.severity_levels import SeverityLevels, nearest_level, severity_levels
+from robohealth_mj.models.boosting import train_early_stopped
+from robohealth_mj.models.severity_levels import (
+    SeverityLevels,
+    level_classifier,
+    median_level,
+    nearest_level,
+    severity_levels,
+)
+
+ROUNDS, PATIENCE = 300, 50
 
 
 def _classifier(x, y, x_val, y_val, params, n):
-    import lightgbm as lgb
-
-    train = lgb.Dataset(x, y)
-    return lgb.train(
-        {**params, "objective": "multiclass", "num_class": n, "metric": "multi_logloss"},
-        train,
-        num_boost_round=300,
-        valid_sets=[lgb.Dataset(x_val, y_val, reference=train)],
-        callbacks=[lgb.early_stopping(50, verbose=False)],
+    return train_early_stopped(
+        level_classifier(params, n), (x, y), (x_val, y_val), ROUNDS, PATIENCE
     )
 
 
 def main() -> None:
-    import lightgbm as lgb
-
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("ckpt", type=Path)
     args = ap.parse_args()
@@ -61,17 +61,12 @@ def main() -> None:
         print(json.dumps({**row, "seconds": round(time.perf_counter() - started, 1)}), flush=True)
 
     def median(dist: np.ndarray) -> np.ndarray:
-        return levels[(np.cumsum(dist, 1) >= 0.5 - 1e-9).argmax(1)]
+        return median_level(dist, levels)
 
     for objective in ("regression", "regression_l1"):
         started = time.perf_counter()
-        train = lgb.Dataset(x, s)
-        booster = lgb.train(
-            {**params, "objective": objective, "metric": "l1"},
-            train,
-            num_boost_round=300,
-            valid_sets=[lgb.Dataset(xv, sv, reference=train)],
-            callbacks=[lgb.early_stopping(50, verbose=False)],
+        booster = train_early_stopped(
+            {**params, "objective": objective, "metric": "l1"}, (x, s), (xv, sv), ROUNDS, PATIENCE
         )
         report(objective, booster.predict(xv), started)
     started = time.perf_counter()
@@ -90,7 +85,9 @@ def main() -> None:
     for name, extra in (("", {}), (", 15 leaves", {"num_leaves": 15}),
                         (", learning rate 0.05", {"learning_rate": 0.05})):  # fmt: skip
         started = time.perf_counter()
-        head, _ = SeverityLevels.fit((x, c, j, s), (xv, cv, jv, sv), {**params, **extra}, 300, 50)
+        head, _ = SeverityLevels.fit(
+            (x, c, j, s), (xv, cv, jv, sv), {**params, **extra}, ROUNDS, PATIENCE
+        )
         report(f"per (class, joint), levels objective{name}", head.predict(xv, classes, joints),
                started)  # fmt: skip
 

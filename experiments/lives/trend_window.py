@@ -55,8 +55,7 @@ def main() -> None:
             tr = c.rul_rows(train, cal, {"trend": est}, lead, floor)
             held = c.rul_rows(scores, cal, {"trend": est}, lead, floor)
             healthy = c.healthy_warnings(scores, cal, est, lead, floor)
-            warned = np.mean([(r["warning_lead_days"] or -1) >= 5 for r in held])
-            tuned = np.mean([(r["warning_lead_days"] or -1) >= 5 for r in tr])
+            warned, tuned = c.warned_share(held), c.warned_share(tr)
             cells = [
                 run.name, window, role, f"{lead:g}, {floor:g}", f"{tuned:.2f}",
                 f"{np.mean([r['prognostic_horizon'] for r in tr]):.1f}",

@@ -25,6 +25,7 @@ from torch import nn
 
 from robohealth_mj import schema
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.models.boosting import train_early_stopped
 from robohealth_mj.models.severity_levels import SeverityLevels
 from robohealth_mj.models.statistics import window_statistics
 
@@ -139,8 +140,6 @@ class GradientBoostedTrees(nn.Module):
         heads (``class``, ``joint``, ``severity``), keeping the others as they are; each head's
         trees depend on its own objective, data and seed alone, so a refit head equals a fresh
         one."""
-        import lightgbm as lgb
-
         params = {**self.params, "seed": int(seed), "num_threads": int(threads or 0)}
         record: dict[str, Any] = {}
         heads = [
@@ -169,19 +168,14 @@ class GradientBoostedTrees(nn.Module):
             self.severity_booster = _booster_bytes(self._boosters["severity"])
         for name, target, pick, objective, metric in heads:
             tr, va = pick(train[1], train[2]), pick(val[1], val[2])
-            dtrain = lgb.Dataset(train[0][tr], train[target][tr], free_raw_data=True)
-            dval = lgb.Dataset(val[0][va], val[target][va], reference=dtrain)
             evals: dict = {}
-            booster = lgb.train(
+            booster = train_early_stopped(
                 {**params, **objective},
-                dtrain,
-                num_boost_round=self.rounds,
-                valid_sets=[dval],
-                valid_names=["val"],
-                callbacks=[
-                    lgb.early_stopping(self.early_stopping_rounds, verbose=False),
-                    lgb.record_evaluation(evals),
-                ],
+                (train[0][tr], train[target][tr]),
+                (val[0][va], val[target][va]),
+                self.rounds,
+                self.early_stopping_rounds,
+                evals,
             )
             self._boosters[name] = booster
             setattr(self, f"{name}_booster", _booster_bytes(booster))

@@ -29,6 +29,8 @@ from typing import Any
 
 import numpy as np
 
+from robohealth_mj.models.boosting import train_early_stopped
+
 
 def severity_levels(severity: np.ndarray, max_levels: int) -> np.ndarray:
     """``[L]`` ascending levels: the distinct values of ``severity`` if at most ``max_levels``,
@@ -43,6 +45,16 @@ def severity_levels(severity: np.ndarray, max_levels: int) -> np.ndarray:
 def nearest_level(severity: np.ndarray, levels: np.ndarray) -> np.ndarray:
     """``[K]`` index of the level nearest each severity."""
     return np.abs(severity[:, None] - levels[None, :]).argmin(1)
+
+
+def median_level(distribution: np.ndarray, levels: np.ndarray) -> np.ndarray:
+    """``[B]`` the level where each row of ``distribution [B, L]`` first sums to one half."""
+    return levels[(np.cumsum(distribution, axis=1) >= 0.5 - 1e-9).argmax(1)]
+
+
+def level_classifier(params: dict[str, Any], n_levels: int) -> dict[str, Any]:
+    """``params`` for a LightGBM multiclass booster over ``n_levels`` severity levels."""
+    return {**params, "objective": "multiclass", "num_class": n_levels, "metric": "multi_logloss"}
 
 
 class SeverityLevels:
@@ -66,8 +78,6 @@ class SeverityLevels:
         """``train``/``val``: (features ``[K, D]``, fault class ``[K]``, joint ``[K]``, severity
         ``[K]``) of faulted windows. Returns the fitted levels and a record (the levels, each
         group's rounds: 0 for a fixed distribution)."""
-        import lightgbm as lgb
-
         feats, fault, joint, severity = train
         levels = severity_levels(severity, max_levels)
         groups: dict[tuple[int, int], Any] = {}
@@ -80,16 +90,13 @@ class SeverityLevels:
                 groups[(c, j)] = np.bincount(y, minlength=len(levels)) / len(y)
                 record["rounds"][f"{c},{j}"] = 0
                 continue
-            dtrain = lgb.Dataset(feats[tr], y, free_raw_data=True)
-            y_val = nearest_level(val[3][va], levels)
-            booster = lgb.train(
-                {**params, "objective": "multiclass", "num_class": len(levels),
-                 "metric": "multi_logloss"},
-                dtrain,
-                num_boost_round=rounds,
-                valid_sets=[lgb.Dataset(val[0][va], y_val, reference=dtrain)],
-                callbacks=[lgb.early_stopping(early_stopping_rounds, verbose=False)],
-            )  # fmt: skip
+            booster = train_early_stopped(
+                level_classifier(params, len(levels)),
+                (feats[tr], y),
+                (val[0][va], nearest_level(val[3][va], levels)),
+                rounds,
+                early_stopping_rounds,
+            )
             groups[(c, j)] = booster
             record["rounds"][f"{c},{j}"] = int(booster.best_iteration)
         record["best_iteration"] = max(record["rounds"].values(), default=0)
@@ -115,8 +122,7 @@ class SeverityLevels:
         self, feats: np.ndarray, class_probs: np.ndarray, joint_probs: np.ndarray
     ) -> np.ndarray:
         """``[B]`` the median level of :meth:`distribution`."""
-        cdf = np.cumsum(self.distribution(feats, class_probs, joint_probs), axis=1)
-        return self.levels[(cdf >= 0.5 - 1e-9).argmax(1)]
+        return median_level(self.distribution(feats, class_probs, joint_probs), self.levels)
 
     def to_bytes(self) -> bytes:
         groups = {

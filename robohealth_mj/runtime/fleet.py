@@ -213,7 +213,8 @@ class FleetRuntime:
             )
         options = ort.SessionOptions()
         options.intra_op_num_threads = threads
-        wanted = execution_providers(providers, ort.get_available_providers())
+        # named providers were checked in __init__; else CUDA where present, else the CPU
+        wanted = list(providers or execution_providers(None, ort.get_available_providers()))
         if "CUDAExecutionProvider" in wanted and hasattr(ort, "preload_dlls"):
             ort.preload_dlls()  # CUDA and cuDNN from the pip-installed nvidia-* packages
 
