@@ -6,7 +6,9 @@ One row per held-out arm and variant: the arm's own model; the leave-one-arm-out
 with ``transfer=true`` on the three other arms) before and after commissioning on ten minutes
 of the arm's healthy running; the commissioned network's false alarms over the arm's healthy
 hour (the monitor's replay with its default alarm policy). Mean ± std over the seeds found.
-Also writes ``results/arms/results_<sensing>.csv``.
+Then each network against ``gbdt`` after commissioning: ahead when the difference of the means
+exceeds the larger seed std. Also writes ``results/arms/results_<sensing>.csv`` (for another
+``--out``, ``results_<its name>_<sensing>.csv``).
 """
 
 from __future__ import annotations
@@ -98,6 +100,32 @@ def markdown(table: dict, sensing: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+def verdict(table: dict, sensing: str, baseline: str = "gbdt") -> str:
+    """The issue's question in one table: each network against the trees on the unseen arm
+    after commissioning, the difference of the means beside the larger of the two seed stds."""
+    lines = [
+        f"### The graph against `{baseline}` on the unseen arm after commissioning, "
+        f"sensing = {sensing}",
+        "",
+        f"| arm | variant | Δ acc. vs {baseline} | larger std | ahead | "
+        f"Δ loc. vs {baseline} | larger std | ahead |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for arm in ARMS:
+        base = table.get((arm, baseline))
+        for variant in sorted(v for a, v in table if a == arm and v != baseline):
+            cells = []
+            for k in ("acc", "loc"):
+                ours, theirs = table[(arm, variant)][f"after_{k}"], (base or {}).get(f"after_{k}")
+                if not ours or not theirs:
+                    cells += ["–", "–", "–"]
+                    continue
+                gap, spread = np.mean(ours) - np.mean(theirs), max(np.std(ours), np.std(theirs))
+                cells += [f"{gap:+.3f}", f"{spread:.3f}", "yes" if gap > spread else "no"]
+            lines.append(f"| {arm} | {variant} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
 def write_csv(table: dict, path: Path) -> None:
     buffer = io.StringIO()
     w = csv.writer(buffer)
@@ -120,8 +148,11 @@ def main() -> None:
     if not table:
         raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
     RESULTS.mkdir(parents=True, exist_ok=True)
-    write_csv(table, RESULTS / f"results_{args.sensing}.csv")
+    recipe = "" if args.out.resolve() == OUT.resolve() else f"{args.out.name}_"
+    write_csv(table, RESULTS / f"results_{recipe}{args.sensing}.csv")
     print(markdown(table, args.sensing))
+    if any(v == "gbdt" for _, v in table):
+        print(verdict(table, args.sensing))
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -19,7 +20,7 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.data.arrays import load_recordings
+from robohealth_mj.data.arrays import Recording, load_recordings
 from robohealth_mj.data.relative import to_raw
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
@@ -44,27 +45,49 @@ class Decisions:
 
 def replay_decisions(model: str | Path, recording: str | Path) -> Decisions:
     """Run the fleet runtime (one stream) over a recording's samples in order."""
-    rec = load_recordings([Path(recording)])
+    return replay_many(model, [recording])[0]
+
+
+def replay_many(model: str | Path, recordings: Sequence[str | Path]) -> list[Decisions]:
+    """:func:`replay_decisions` for several recordings at once: one stream each in one fleet, so
+    the network runs once a tick for all of them. Streams are independent: each recording gets
+    the decisions it gets alone, its probabilities to float32 rounding (a batch runs other
+    kernels than one stream). A shorter recording's stream stops at its end."""
     fleet = FleetRuntime(model)
     if fleet.engine is None:
         raise InputError(fleet.problem)
-    if rec.arms and rec.arms[0] != fleet.arm:
-        raise InputError(
-            f"{recording}: a recording of a {rec.arms[0]}; {model} reads a {fleet.arm} (export "
-            f"one for the {rec.arms[0]}: python -m robohealth_mj.export data=<that recording>)"
+    recs = [load_recordings([Path(r)]) for r in recordings]
+    for recording, rec in zip(recordings, recs, strict=True):
+        if rec.arms and rec.arms[0] != fleet.arm:
+            raise InputError(
+                f"{recording}: a recording of a {rec.arms[0]}; {model} reads a {fleet.arm} "
+                f"(export one for the {rec.arms[0]}: python -m robohealth_mj.export "
+                f"data=<that recording>)"
+            )
+    raws = [to_raw(rec.x, fleet.arm) for rec in recs]  # the runtime takes readings as they come
+    slots = fleet.register([f"{k}:{r}" for k, r in enumerate(recordings)])
+    lengths = np.array([len(rec) for rec in recs])
+    decided = [np.zeros(n, bool) for n in lengths]
+    probs = [np.zeros((n, len(fleet.classes)), np.float32) for n in lengths]
+    scores = [np.zeros((n, len(fleet.joints)), np.float32) for n in lengths]
+    for k in range(int(lengths.max(initial=0))):
+        live = np.flatnonzero(lengths > k)
+        index = np.array([recs[i].sample_index[k] for i in live])
+        r = fleet.step(slots[live], index, index * 0.05 + 0.05,
+                       np.stack([raws[i][k] for i in live]))  # fmt: skip
+        for row, i in enumerate(live.tolist()):
+            decided[i][k] = r.status[row] == DECIDED
+            probs[i][k], scores[i][k] = r.probs[row], r.joint_scores[row]
+    return [
+        Decisions(
+            decided[i], probs[i], scores[i], _truth(rec), fleet.window, *joint_activity(rec.x)
         )
-    raw = to_raw(rec.x, fleet.arm)  # the runtime takes the arm's readings as they arrive
-    slot = fleet.register([str(recording)])
-    n = len(rec)
-    decided = np.zeros(n, bool)
-    probs = np.zeros((n, len(fleet.classes)), np.float32)
-    scores = np.zeros((n, len(fleet.joints)), np.float32)
-    for k in range(n):
-        r = fleet.step(slot, rec.sample_index[k : k + 1], rec.sample_index[k : k + 1] * 0.05 + 0.05,
-                       raw[k : k + 1])  # fmt: skip
-        decided[k] = r.status[0] == DECIDED
-        probs[k], scores[k] = r.probs[0], r.joint_scores[0]
-    truth = [
+        for i, rec in enumerate(recs)
+    ]
+
+
+def _truth(rec: Recording) -> list[FaultLabel]:
+    return [
         FaultLabel(
             schema.FAULT_CLASSES[int(c)],
             schema.JOINT_NAMES[int(j)] if j >= 0 else None,
@@ -75,8 +98,6 @@ def replay_decisions(model: str | Path, recording: str | Path) -> Decisions:
             rec.fault_class, rec.fault_joint, rec.severity, rec.active, strict=True
         )
     ]
-    speed, torque = joint_activity(rec.x)
-    return Decisions(decided, probs, scores, truth, fleet.window, speed, torque)
 
 
 def accumulate(d: Decisions, evidence: EvidencePolicy) -> np.ndarray:

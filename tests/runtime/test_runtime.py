@@ -4,6 +4,7 @@ input, the no-model fallback, interleaved streams and on-line detection latency.
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ import torch
 from robohealth_mj import schema
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.windows import make_windows
-from robohealth_mj.deploy.alarm_sweep import evaluate_policy, replay_decisions
+from robohealth_mj.deploy.alarm_sweep import evaluate_policy, replay_decisions, replay_many
 from robohealth_mj.deploy.export import RawInput, export_checkpoint, read_metadata
 from robohealth_mj.learn.checkpoint import load_checkpoint, model_from_checkpoint
 from robohealth_mj.monitor import main as monitor_main
@@ -345,6 +346,28 @@ def test_monitor_replays_and_evaluates_with_its_alarm_settings(
                             deciding_alarm)  # fmt: skip
     for key in ("alarms", "false_alarms", "settled_healthy_ticks", "online_accuracy"):
         assert swept[key] == result[key], key
+
+
+def test_recordings_replayed_together_get_the_decisions_each_gets_alone(deployed, tmp_path):
+    """``replay_many`` runs one stream per recording in one fleet (how the cross-arm campaign
+    counts alarms over three healthy sessions at once): each recording's decisions, classes and
+    truth are those it gets replayed alone, a shorter one's included; the probabilities agree to
+    float32 rounding (a batch of two runs other kernels than a batch of one)."""
+    heldout = Path(deployed["heldout"])
+    short = tmp_path / "short" / "graphs.jsonl"
+    short.parent.mkdir()
+    lines = heldout.read_text().splitlines(keepends=True)
+    short.write_text("".join(lines[len(lines) // 3 : len(lines) // 2]))
+    together = replay_many(deployed["structural_onnx"], [heldout, short])
+    for recording, joint in zip([heldout, short], together, strict=True):
+        alone = replay_decisions(deployed["structural_onnx"], recording)
+        assert len(joint.truth) == len(alone.truth) and joint.truth == alone.truth
+        assert joint.decided.any() and np.array_equal(joint.decided, alone.decided)
+        np.testing.assert_allclose(joint.probs, alone.probs, atol=1e-5)
+        np.testing.assert_allclose(joint.joint_scores, alone.joint_scores, atol=1e-5)
+        decided = alone.decided
+        assert np.array_equal(joint.probs[decided].argmax(1), alone.probs[decided].argmax(1))
+    assert len(together[1].truth) < len(together[0].truth)
 
 
 def test_monitor_diagnoses_the_simulator_live(deployed, deciding_alarm_args, tmp_path, capsys):
