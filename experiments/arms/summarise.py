@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from robohealth_mj.reporting.markdown import heading
+
 ROOT = Path(__file__).resolve().parents[2]
 OUT = ROOT / "outputs" / "campaign_arms"
 RESULTS = ROOT / "results" / "arms"
@@ -78,14 +80,12 @@ COLUMNS = ("own_acc", "own_loc", "loao_acc", "loao_loc", "after_acc", "after_loc
 
 
 def markdown(table: dict, sensing: str) -> str:
-    lines = [
-        f"### Cross-arm, sensing = {sensing} (held-out session of each arm, W = 32)",
-        "",
-        "| arm | variant | seeds (own / unseen) | own acc. | own loc. | unseen acc. | "
-        "unseen loc. | commissioned acc. | commissioned loc. | Δ acc. vs own | Δ loc. vs own | "
-        "false alarms / healthy h |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
-    ]
+    lines = heading(
+        f"Cross-arm, sensing = {sensing} (held-out session of each arm, W = 32)",
+        ["arm", "variant", "seeds (own / unseen)", "own acc.", "own loc.", "unseen acc.",
+         "unseen loc.", "commissioned acc.", "commissioned loc.", "Δ acc. vs own",
+         "Δ loc. vs own", "false alarms / healthy h"],
+    )  # fmt: skip
     for arm in ARMS:
         for variant in sorted({v for a, v in table if a == arm}):
             r = table[(arm, variant)]
@@ -109,13 +109,11 @@ def markdown(table: dict, sensing: str) -> str:
 def validation(table: dict, sensing: str) -> str:
     """What selection may read: each leave-one-arm-out model's run-aware validation split of its
     three training arms (at its best epoch), beside the unseen arm it is then scored on."""
-    lines = [
-        f"### Validation (the training arms' split) and the unseen arm, sensing = {sensing}",
-        "",
-        "| unseen arm | variant | epochs | validation acc. | validation loc. | unseen acc. | "
-        "unseen loc. | train s / run |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
+    lines = heading(
+        f"Validation (the training arms' split) and the unseen arm, sensing = {sensing}",
+        ["unseen arm", "variant", "epochs", "validation acc.", "validation loc.", "unseen acc.",
+         "unseen loc.", "train s / run"],
+    )  # fmt: skip
     for arm in ARMS:
         for variant in sorted({v for a, v in table if a == arm}):
             r = table[(arm, variant)]
@@ -133,14 +131,12 @@ def validation(table: dict, sensing: str) -> str:
 def verdict(table: dict, sensing: str, baseline: str = "gbdt") -> str:
     """The issue's question in one table: each network against the trees on the unseen arm
     after commissioning, the difference of the means beside the larger of the two seed stds."""
-    lines = [
-        f"### The graph against `{baseline}` on the unseen arm after commissioning, "
+    lines = heading(
+        f"The graph against `{baseline}` on the unseen arm after commissioning, "
         f"sensing = {sensing}",
-        "",
-        f"| arm | variant | Δ acc. vs {baseline} | larger std | ahead | "
-        f"Δ loc. vs {baseline} | larger std | ahead |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
+        ["arm", "variant", f"Δ acc. vs {baseline}", "larger std", "ahead",
+         f"Δ loc. vs {baseline}", "larger std", "ahead"],
+    )  # fmt: skip
     for arm in ARMS:
         base = table.get((arm, baseline))
         for variant in sorted(v for a, v in table if a == arm and v != baseline):
