@@ -86,8 +86,7 @@ def rescore(run_dir: Path, arm: str) -> None:
         kept = run_dir / f"eval_heldout_trained.{ext}"
         if not kept.is_file():
             shutil.copy2(run_dir / f"eval_heldout.{ext}", kept)
-    run("robohealth_mj.evaluate", f"ckpt={run_dir / 'best.ckpt'}",
-        f"data={CORPUS / arm / 'heldout_seed900'}", f"out={run_dir / 'eval_heldout'}")  # fmt: skip
+    score(run_dir, arm)
 
 
 @cache
@@ -103,8 +102,13 @@ def commission_and_score(run_dir: Path, arm: str) -> None:
         run("robohealth_mj.commission", f"model={run_dir / 'best.ckpt'}",
             f"healthy={CORPUS / arm / 'healthy_commissioning_seed940'}", f"out={done}")  # fmt: skip
     if not (done / "eval_heldout.json").is_file():
-        run("robohealth_mj.evaluate", f"ckpt={done / 'best.ckpt'}",
-            f"data={CORPUS / arm / 'heldout_seed900'}", f"out={done / 'eval_heldout'}")  # fmt: skip
+        score(done, arm)
+
+
+def score(run_dir: Path, arm: str) -> None:
+    """``run_dir``'s checkpoint on ``arm``'s held-out session, as ``eval_heldout.json``."""
+    run("robohealth_mj.evaluate", f"ckpt={run_dir / 'best.ckpt'}",
+        f"data={CORPUS / arm / 'heldout_seed900'}", f"out={run_dir / 'eval_heldout'}")  # fmt: skip
 
 
 def healthy_alarms(done: Path, arm: str) -> None:
