@@ -8,6 +8,7 @@ taken every ``stride`` snapshots and labelled by its *final* snapshot, or (``lab
 from __future__ import annotations
 
 import itertools
+import re
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -67,36 +68,60 @@ def target_joint_moved(
 SPLITS = ("train", "val", "test")
 
 
+_RECORDED_RUN_ID = re.compile(r"^[a-z0-9_]+-s(?P<seed>\d+)-[0-9a-f]{10}$")
+
+
+def session_of(run_id: str) -> str:
+    """The simulated session a run id names, whatever arm ran it.
+
+    The recorder names a run ``<arm>-s<seed>-<digest>`` (``recording.recorder.default_run_id``),
+    and a corpus records every arm from the same session seeds: one seed is one program and one
+    fault schedule, scaled to the arm. Splitting by run id alone would put the UR10e's session 100
+    in validation while the UR5e's session 100 trains. Any other id (an ingested log, a bag, a
+    named session) is a session of its own.
+    """
+    match = _RECORDED_RUN_ID.match(run_id)
+    return f"seed {match['seed']}" if match else run_id
+
+
 def run_aware_split(
     rec: Recording,
     windows: Windows,
     seed: int,
     fractions: tuple[float, float, float] = (0.7, 0.15, 0.15),
 ) -> dict[str, Windows]:
-    """Whole sessions (by the run id of each window's final snapshot) to train/val/test.
+    """Whole sessions to train/val/test: a window goes where the session of its final snapshot's
+    run goes, and runs of one session on several arms (:func:`session_of`) go together.
 
-    Seeded greedy assignment: sessions in a seeded random order; the first three seed the three
-    splits, each further session goes to the split furthest below its target share of windows.
+    Seeded greedy assignment: sessions in a seeded random order (from the order of their first
+    run); the first three seed the three splits, each further session goes to the split furthest
+    below its target share of windows. One arm's corpus (a session per run) splits as by run.
     """
     run_of = rec.run[windows.end]
-    runs, counts = np.unique(run_of, return_counts=True)
-    if len(runs) < 3:
+    runs = np.unique(run_of)
+    names = [session_of(rec.run_ids[r]) for r in runs]
+    sessions = list(dict.fromkeys(names))  # in the order of their first run
+    if len(sessions) < 3:
         raise InputError(
             f"the run-aware split needs at least 3 recording sessions, got "
-            f"{len(runs)} ({[rec.run_ids[r] for r in runs]}); record more sessions"
+            f"{len(sessions)} ({sessions}); record more sessions"
         )
-    order = np.random.default_rng(seed).permutation(len(runs))
+    session_of_run = np.full(len(rec.run_ids), -1)
+    session_of_run[runs] = [sessions.index(n) for n in names]
+    session_of_window = session_of_run[run_of]
+    counts = np.bincount(session_of_window, minlength=len(sessions))
+    order = np.random.default_rng(seed).permutation(len(sessions))
     total = counts.sum()
     assigned = np.zeros(3)
-    split_of: dict[int, int] = {}
+    split_of = np.zeros(len(sessions), int)
     for position, k in enumerate(order):
         if position < 3:
             target = position
         else:
             target = int(np.argmax(np.asarray(fractions) * total - assigned))
-        split_of[int(runs[k])] = target
+        split_of[k] = target
         assigned[target] += counts[k]
-    which = np.array([split_of[int(r)] for r in run_of])
+    which = split_of[session_of_window]
     return {name: windows.subset(which == i) for i, name in enumerate(SPLITS)}
 
 
