@@ -1,6 +1,6 @@
 """The cross-arm table from the campaign's evaluations (``experiments/arms/campaign.py``).
 
-    python experiments/arms/summarise.py [--sensing full] > results/arms/results.md
+    python experiments/arms/summarise.py [--sensing full] [--out DIR] [--seeds 42]
 
 One row per held-out arm and variant: the arm's own model; the leave-one-arm-out model (trained
 with ``transfer=true`` on the three other arms) before and after commissioning on ten minutes
@@ -35,12 +35,17 @@ def _metrics(path: Path) -> dict | None:
     return json.loads(path.read_text())["metrics"] if path.is_file() else None
 
 
-def collect(sensing: str, out: Path = OUT) -> dict[tuple[str, str], dict[str, list[float]]]:
-    """``(arm, variant) -> {column: [one value per seed]}``."""
+def collect(
+    sensing: str, out: Path = OUT, seeds: set[str] | None = None
+) -> dict[tuple[str, str], dict[str, list[float]]]:
+    """``(arm, variant) -> {column: [one value per seed]}`` (``seeds``: only these, e.g.
+    ``{"42"}``, to set one seed of two campaigns side by side)."""
     table: dict[tuple[str, str], dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
     for stage in ("own", "loao"):
         for ev in sorted((out / sensing / stage).glob("*/**/seed*/eval_heldout.json")):
             run = ev.parent
+            if seeds is not None and run.name.removeprefix("seed") not in seeds:
+                continue
             arm = run.relative_to(out / sensing / stage).parts[0]
             variant = run.parts[-3]
             row = table[(arm, variant)]
@@ -53,6 +58,7 @@ def collect(sensing: str, out: Path = OUT) -> dict[tuple[str, str], dict[str, li
             row[f"{stage}_val_loc"].append(best["val_localisation"])
             row[f"{stage}_train_s"].append(summary["train_seconds"])
             row[f"{stage}_epochs"].append(summary["epochs"])
+            row[f"{stage}_selected"].append(selected(best, summary["best_epoch"]))
             after = _metrics(run / "commissioned" / "eval_heldout.json")
             if stage == "loao" and after is not None:
                 row["after_acc"].append(after["accuracy"])
@@ -65,6 +71,13 @@ def collect(sensing: str, out: Path = OUT) -> dict[tuple[str, str], dict[str, li
                 row["false_alarms_per_hour"].append(sum(a["false_alarms"] for a in alarms) / hours)
                 row["healthy_hours"].append(hours)
     return table
+
+
+def selected(best: dict, best_epoch: int) -> int:
+    """What validation selected: the best epoch of a network, the class booster's rounds of
+    ``gbdt`` (early stopping on the validation split)."""
+    boosting = best.get("boosting")
+    return int(boosting["class"]["best_iteration"]) if boosting else int(best_epoch)
 
 
 def _cell(values: list[float], digits: int = 3) -> str:
@@ -111,8 +124,8 @@ def validation(table: dict, sensing: str) -> str:
     three training arms (at its best epoch), beside the unseen arm it is then scored on."""
     lines = heading(
         f"Validation (the training arms' split) and the unseen arm, sensing = {sensing}",
-        ["unseen arm", "variant", "epochs", "validation acc.", "validation loc.", "unseen acc.",
-         "unseen loc.", "train s / run"],
+        ["unseen arm", "variant", "epochs", "selected (epoch; gbdt: rounds)", "validation acc.",
+         "validation loc.", "unseen acc.", "unseen loc.", "train s / run"],
     )  # fmt: skip
     for arm in ARMS:
         for variant in sorted({v for a, v in table if a == arm}):
@@ -121,7 +134,8 @@ def validation(table: dict, sensing: str) -> str:
                 continue
             epochs = "/".join(str(e) for e in sorted(set(r["loao_epochs"])))
             lines.append(
-                f"| {arm} | {variant} | {epochs} | {_cell(r['loao_val_acc'])} | "
+                f"| {arm} | {variant} | {epochs} | {_cell(r['loao_selected'], 0)} | "
+                f"{_cell(r['loao_val_acc'])} | "
                 f"{_cell(r['loao_val_loc'])} | {_cell(r['loao_acc'])} | {_cell(r['loao_loc'])} | "
                 f"{np.mean(r['loao_train_s']):.0f} |"
             )
@@ -169,12 +183,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sensing", default="full")
     parser.add_argument("--out", type=Path, default=OUT, help="campaign root")
+    parser.add_argument("--seeds", help="only these seeds, e.g. 42 or 42,43 (default: all found)")
     args = parser.parse_args()
-    table = collect(args.sensing, args.out)
+    seeds = set(args.seeds.split(",")) if args.seeds else None
+    table = collect(args.sensing, args.out, seeds)
     if not table:
         raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
     RESULTS.mkdir(parents=True, exist_ok=True)
     recipe = "" if args.out.resolve() == OUT.resolve() else f"{args.out.name}_"
+    recipe += f"seeds{'_'.join(sorted(seeds))}_" if seeds else ""
     write_csv(table, RESULTS / f"results_{recipe}{args.sensing}.csv")
     print(markdown(table, args.sensing))
     if any(v == "gbdt" for _, v in table):
