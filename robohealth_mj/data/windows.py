@@ -71,12 +71,18 @@ SPLITS = ("train", "val", "test")
 _RECORDED_RUN_ID = re.compile(r"^[a-z0-9_]+-s(?P<seed>\d+)-[0-9a-f]{10}$")
 
 
+def recorded_run_id(arm: str, seed: int, digest: str) -> str:
+    """The id the recorder gives a simulated session (``digest``: 10 hex digits of its config),
+    in the one format :func:`session_of` reads back."""
+    return f"{arm}-s{seed}-{digest}"
+
+
 def session_of(run_id: str) -> str:
     """The simulated session a run id names, whatever arm ran it.
 
-    The recorder names a run ``<arm>-s<seed>-<digest>`` (``recording.recorder.default_run_id``),
-    and a corpus records every arm from the same session seeds: one seed is one program and one
-    fault schedule, scaled to the arm. Splitting by run id alone would put the UR10e's session 100
+    The recorder names a run ``<arm>-s<seed>-<digest>`` (:func:`recorded_run_id`), and a corpus
+    records every arm from the same session seeds: one seed is one program and one fault
+    schedule, scaled to the arm. Splitting by run id alone would put the UR10e's session 100
     in validation while the UR5e's session 100 trains. Any other id (an ingested log, a bag, a
     named session) is a session of its own.
     """
@@ -106,8 +112,9 @@ def run_aware_split(
             f"the run-aware split needs at least 3 recording sessions, got "
             f"{len(sessions)} ({sessions}); record more sessions"
         )
+    index = {name: i for i, name in enumerate(sessions)}
     session_of_run = np.full(len(rec.run_ids), -1)
-    session_of_run[runs] = [sessions.index(n) for n in names]
+    session_of_run[runs] = [index[n] for n in names]
     session_of_window = session_of_run[run_of]
     counts = np.bincount(session_of_window, minlength=len(sessions))
     order = np.random.default_rng(seed).permutation(len(sessions))

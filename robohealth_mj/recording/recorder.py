@@ -27,6 +27,7 @@ from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.version import code_version
 from robohealth_mj.data.jsonl import format_line, node_features
+from robohealth_mj.data.windows import recorded_run_id
 from robohealth_mj.faults.injector import FaultInjector
 from robohealth_mj.recording.arm import ArmSimulator, TickChunk
 from robohealth_mj.schema import (
@@ -55,7 +56,7 @@ def default_run_id(cfg: DictConfig) -> str:
     data = session_config(cfg)
     data["session"] = {k: v for k, v in data["session"].items() if k not in _IDENTITY_EXCLUDE}
     digest = hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:10]
-    return f"{arm_name(cfg)}-s{cfg.seed}-{digest}"
+    return recorded_run_id(arm_name(cfg), cfg.seed, digest)
 
 
 def arm_name(cfg: DictConfig) -> str:
