@@ -3,7 +3,7 @@ commissioning, and false alarms on the unseen arm's healthy hour.
 
     python experiments/arms/campaign.py [--variants gbdt,stgnn_fixed] [--seeds 42,43,44]
         [--epochs 10] [--sensing full] [--arms ur3e,ur5e,ur10e,ur16e] [--stages own,loao]
-        [--steps train,rescore,commission,alarms]
+        [--steps train,rescore,commission,alarms] [--healthy-rate 0.99]
 
 Reads the per-arm corpora ``outputs/corpus/arms/<arm>`` (``python -m robohealth_mj.corpus
 corpus=arms ...``, see ``results/arms/command.sh``) and writes under ``outputs/campaign_arms``:
@@ -13,7 +13,9 @@ corpus=arms ...``, see ``results/arms/command.sh``) and writes under ``outputs/c
   ``<arm>``'s held-out session; ``commissioned/`` beside each: the model commissioned on ten
   minutes of ``<arm>``'s healthy running and scored again; networks are also replayed through the
   fleet runtime and the monitor's alarms over ``<arm>``'s healthy hour
-  (``alarms_healthy_hour_seed*.json``).
+  (``alarms_healthy_hour_seed*.json``). With ``--healthy-rate R`` the commissioning asks for at
+  least R of the arm's healthy windows called healthy (``commission healthy_rate=R``, a quieter
+  operating point) and writes ``commissioned_hr<R>/`` instead.
 
 Every step skips what is done, so an interrupted campaign resumes. Training runs through the
 package's own entry points (Hydra multirun, two jobs of one thread).
@@ -94,13 +96,23 @@ def heldout_fingerprint(arm: str) -> str:
     return load_recordings(expand_paths([str(CORPUS / arm / "heldout_seed900")])).fingerprint()
 
 
-def commission_and_score(run_dir: Path, arm: str) -> None:
+def commissioned_dir(run_dir: Path, healthy_rate: float | None = None) -> Path:
+    """Where ``run_dir``'s model commissioned at validation's healthy rate (``None``) or at
+    ``healthy_rate`` lives."""
+    return run_dir / (
+        "commissioned" if healthy_rate is None else f"commissioned_hr{healthy_rate:g}"
+    )
+
+
+def commission_and_score(run_dir: Path, arm: str, healthy_rate: float | None = None) -> None:
     """Commission ``run_dir``'s model on ``arm``'s healthy ten minutes and score it on ``arm``'s
     held-out session."""
-    done = run_dir / "commissioned"
+    done = commissioned_dir(run_dir, healthy_rate)
+    rate = [] if healthy_rate is None else [f"healthy_rate={healthy_rate:g}"]
     if not (done / "best.ckpt").is_file():
         run("robohealth_mj.commission", f"model={run_dir / 'best.ckpt'}",
-            f"healthy={CORPUS / arm / 'healthy_commissioning_seed940'}", f"out={done}")  # fmt: skip
+            f"healthy={CORPUS / arm / 'healthy_commissioning_seed940'}", f"out={done}",
+            *rate)  # fmt: skip
     if not (done / "eval_heldout.json").is_file():
         score(done, arm)
 
@@ -155,6 +167,12 @@ def main() -> None:
     parser.add_argument(
         "--out", type=Path, default=OUT, help="campaign root (a variant recipe's own)"
     )
+    parser.add_argument(
+        "--healthy-rate",
+        type=float,
+        help="commission at this healthy rate (e.g. 0.99) into commissioned_hr<R>/ "
+        "(default: validation's rate, into commissioned/)",
+    )
     args = parser.parse_args()
     arms = args.arms.split(",")
     missing = [a for a in arms if not (CORPUS / a / "corpus.json").is_file()]
@@ -181,10 +199,11 @@ def main() -> None:
             for run_dir in runs(sweep, variants):
                 if "rescore" in steps:
                     rescore(run_dir, arm)
+                done = commissioned_dir(run_dir, args.healthy_rate)
                 if "commission" in steps:
-                    commission_and_score(run_dir, arm)
-                if "alarms" in steps and (run_dir / "commissioned" / "model.onnx").is_file():
-                    healthy_alarms(run_dir / "commissioned", arm)  # networks: a streaming runtime
+                    commission_and_score(run_dir, arm, args.healthy_rate)
+                if "alarms" in steps and (done / "model.onnx").is_file():
+                    healthy_alarms(done, arm)  # networks: a streaming runtime
 
 
 if __name__ == "__main__":

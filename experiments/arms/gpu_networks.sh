@@ -1,28 +1,52 @@
 #!/usr/bin/env bash
-# Issue 36's networks on a lent GPU machine, as run on 2026-11-26 (one NVIDIA H200, 16 cores;
-# 96 jobs in 8 minutes): each arm's training and held-out sessions recorded there, then every
+# Issue 36's networks on a lent GPU machine (one NVIDIA H200, 16 cores): each arm's training and
+# held-out sessions recorded there and parsed once into their array caches, then every job
 # (sensing, stage, arm, variant, seed) trained at 30 epochs, PAR at a time (one CPU thread each,
-# all on the one GPU; start CUDA MPS first where the machine has it), and the run directories
-# packed to bring back. The rest runs where the full corpora are (results/arms/command.sh):
-#   python experiments/arms/campaign.py --variants stgnn_fixed,anomaly_residual \
+# all on the one GPU), and the run directories packed to bring back. The rest runs where the full
+# corpora are (results/arms/command.sh):
+#   python experiments/arms/campaign.py --out "$CAMPAIGN" --variants stgnn_fixed,anomaly_residual \
 #     --steps rescore,commission,alarms
-# From the repository root, with the package installed (pip install '.[full]').
-set -euo pipefail
+# From the repository root, with the package importable.
+#   experiments/arms/gpu_networks.sh [JOBS_FILE]
+# JOBS_FILE holds one job per line, "sensing stage arm variant seed"; without it, the campaign of
+# 2026-11-26 (96 jobs, 8 minutes): both variants (stgnn_fixed alone on the stock profile, which has
+# no sensor nodes for a coupling head), own and leave-one-arm-out, seeds 42-44.
+# Environment: PY (python), PAR (jobs at a time, 16), CAMPAIGN (campaign root,
+# outputs/campaign_arms), BUDGET_S (seconds from this script's start after which the trainings are
+# stopped, so that the runs that finished are packed inside a lease), PACK (the archive,
+# outputs/campaign_arms_gpu.tgz). Start CUDA MPS first where the machine has it.
+set -uo pipefail
 PY=${PY:-python3}
 PAR=${PAR:-16}
+export CAMPAIGN=${CAMPAIGN:-outputs/campaign_arms}
+BUDGET_S=${BUDGET_S:-3600}
+PACK=${PACK:-outputs/campaign_arms_gpu.tgz}
+CORPUS=outputs/corpus/arms
+
+all_jobs() {
+  for sensing in full stock; do
+    variants=$([ $sensing = full ] && echo "stgnn_fixed anomaly_residual" || echo stgnn_fixed)
+    for stage in loao own; do for arm in ur3e ur5e ur10e ur16e; do for variant in $variants; do
+      for seed in 42 43 44; do echo "$sensing $stage $arm $variant $seed"; done
+    done; done; done
+  done
+}
+
 for arm in ur5e ur10e ur3e ur16e; do
-  $PY -m robohealth_mj.corpus corpus=arms out_dir="outputs/corpus/arms/$arm" \
+  $PY -m robohealth_mj.corpus corpus=arms out_dir="$CORPUS/$arm" \
     "record_overrides=[\"arm=$arm\"]" progress=false jobs=4 '~corpus.healthy_commissioning' \
     '~corpus.healthy_hour' '~corpus.probe_payload_high' &
 done
 wait
-# the stock profile has no sensor nodes, so no coupling head: stgnn_fixed alone there
-for sensing in full stock; do
-  variants=$([ $sensing = full ] && echo "stgnn_fixed anomaly_residual" || echo stgnn_fixed)
-  for stage in loao own; do for arm in ur3e ur5e ur10e ur16e; do for variant in $variants; do
-    for seed in 42 43 44; do echo "$sensing $stage $arm $variant $seed"; done
-  done; done; done
-done | xargs -P "$PAR" -L 1 sh -c '"$0" experiments/arms/campaign.py --steps train --epochs 30 \
-  --sensing "$1" --stages "$2" --arms "$3" --variants "$4" --seeds "$5" \
-  > "outputs/gpu_$1_$2_$3_$4_$5.log" 2>&1' "$PY"
-tar -czf outputs/campaign_arms_gpu.tgz --exclude=tensorboard --exclude=.hydra outputs/campaign_arms
+# every training reads all of these: parse each once here rather than once per job
+ls "$CORPUS"/*/*/graphs.jsonl | xargs -P "$PAR" -I{} "$PY" -c \
+  "from robohealth_mj.data.arrays import load_recordings; load_recordings(['{}'])"
+echo "corpora parsed after $SECONDS s"
+mkdir -p outputs/gpu_logs
+{ if [ $# -ge 1 ]; then cat "$1"; else all_jobs; fi; } |
+  timeout $((BUDGET_S - SECONDS)) xargs -P "$PAR" -L 1 sh -c '"$0" experiments/arms/campaign.py \
+    --out "$CAMPAIGN" --steps train --epochs 30 --sensing "$1" --stages "$2" --arms "$3" \
+    --variants "$4" --seeds "$5" > "outputs/gpu_logs/$1_$2_$3_$4_$5.log" 2>&1
+    echo "$1 $2 $3 $4 $5 rc=$?" >> outputs/gpu_logs/done.txt' "$PY"
+echo "trainings: exit $? after $SECONDS s"
+tar -czf "$PACK" --exclude=tensorboard --exclude=.hydra "$CAMPAIGN" outputs/gpu_logs

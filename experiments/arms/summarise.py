@@ -1,6 +1,7 @@
 """The cross-arm table from the campaign's evaluations (``experiments/arms/campaign.py``).
 
     python experiments/arms/summarise.py [--sensing full] [--out DIR] [--seeds 42]
+        [--healthy-rate 0.99]
 
 One row per held-out arm and variant: the arm's own model; the leave-one-arm-out model (trained
 with ``transfer=true`` on the three other arms) before and after commissioning on ten minutes
@@ -8,7 +9,8 @@ of the arm's healthy running; the commissioned network's false alarms over the a
 hour (the monitor's replay with its default alarm policy). Mean ± std over the seeds found.
 Then each network against ``gbdt`` after commissioning: ahead when the difference of the means
 exceeds the larger seed std. Also writes ``results/arms/results_<sensing>.csv`` (for another
-``--out``, ``results_<its name>_<sensing>.csv``).
+``--out``, ``results_<its name>_<sensing>.csv``). ``--healthy-rate R`` reads the models
+commissioned at that healthy rate (``campaign.py --healthy-rate R``) in place of validation's.
 """
 
 from __future__ import annotations
@@ -36,10 +38,14 @@ def _metrics(path: Path) -> dict | None:
 
 
 def collect(
-    sensing: str, out: Path = OUT, seeds: set[str] | None = None
+    sensing: str,
+    out: Path = OUT,
+    seeds: set[str] | None = None,
+    commissioned: str = "commissioned",
 ) -> dict[tuple[str, str], dict[str, list[float]]]:
     """``(arm, variant) -> {column: [one value per seed]}`` (``seeds``: only these, e.g.
-    ``{"42"}``, to set one seed of two campaigns side by side)."""
+    ``{"42"}``, to set one seed of two campaigns side by side; ``commissioned``: the directory
+    of the commissioned models to read)."""
     table: dict[tuple[str, str], dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
     for stage in ("own", "loao"):
         for ev in sorted((out / sensing / stage).glob("*/**/seed*/eval_heldout.json")):
@@ -59,12 +65,12 @@ def collect(
             row[f"{stage}_train_s"].append(summary["train_seconds"])
             row[f"{stage}_epochs"].append(summary["epochs"])
             row[f"{stage}_selected"].append(selected(best, summary["best_epoch"]))
-            after = _metrics(run / "commissioned" / "eval_heldout.json")
+            after = _metrics(run / commissioned / "eval_heldout.json")
             if stage == "loao" and after is not None:
                 row["after_acc"].append(after["accuracy"])
                 row["after_loc"].append(after["localisation_accuracy"])
             alarms = [
-                json.loads(p.read_text()) for p in sorted(run.glob("commissioned/alarms_*.json"))
+                json.loads(p.read_text()) for p in sorted(run.glob(f"{commissioned}/alarms_*.json"))
             ]
             if stage == "loao" and alarms:
                 hours = sum(a["settled_healthy_ticks"] for a in alarms) * TICK_S / 3600
@@ -184,14 +190,20 @@ def main() -> None:
     parser.add_argument("--sensing", default="full")
     parser.add_argument("--out", type=Path, default=OUT, help="campaign root")
     parser.add_argument("--seeds", help="only these seeds, e.g. 42 or 42,43 (default: all found)")
+    parser.add_argument(
+        "--healthy-rate", type=float, help="the models commissioned at this healthy rate"
+    )
     args = parser.parse_args()
     seeds = set(args.seeds.split(",")) if args.seeds else None
-    table = collect(args.sensing, args.out, seeds)
+    rate = args.healthy_rate
+    commissioned = "commissioned" if rate is None else f"commissioned_hr{rate:g}"
+    table = collect(args.sensing, args.out, seeds, commissioned)
     if not table:
         raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
     RESULTS.mkdir(parents=True, exist_ok=True)
     recipe = "" if args.out.resolve() == OUT.resolve() else f"{args.out.name}_"
     recipe += f"seeds{'_'.join(sorted(seeds))}_" if seeds else ""
+    recipe += f"hr{rate:g}_" if rate is not None else ""
     write_csv(table, RESULTS / f"results_{recipe}{args.sensing}.csv")
     print(markdown(table, args.sensing))
     if any(v == "gbdt" for _, v in table):
