@@ -11,8 +11,11 @@
 #      scored again on this machine's recording of the held-out session, each leave-one-arm-out
 #      model commissioned on the unseen arm's ten healthy minutes and scored, each commissioned
 #      network's alarms counted over the unseen arm's healthy hour;
-#   4. the tables (results/arms/table_full_split_by_run.md, table_stock.md) and the recorder per arm;
-#   5. the leave-one-arm-out models again on the fixed split (results/arms/table_full.md).
+#   4. the tables (results/arms/table_full_split_by_run.md, table_stock_split_by_run.md) and the
+#      recorder per arm;
+#   5. the leave-one-arm-out models again on the fixed split, seed 42;
+#   6. three seeds on the fixed split, the stock profile with gbdt, and the stricter operating
+#      point (results/arms/table_full.md, table_stock.md, table_full_hr0.99.md).
 # The 10-epoch campaign of 2026-11-25 (own models seed 42, networks 10 epochs, full sensing) is
 # results/arms/table_full_e10.md; its relative-channel ablation results/arms/raw_channels.md.
 set -euo pipefail
@@ -34,7 +37,7 @@ $C --variants stgnn_fixed --sensing stock --steps alarms
 # across arms (docs/arms.md): kept as *_split_by_run.md. (Steps 2-3 ran at commit e37b51a; on
 # today's code their leave-one-arm-out trainings split by session, as step 5 does.)
 $PY experiments/arms/summarise.py --sensing full > results/arms/table_full_split_by_run.md
-$PY experiments/arms/summarise.py --sensing stock > results/arms/table_stock.md
+$PY experiments/arms/summarise.py --sensing stock > results/arms/table_stock_split_by_run.md
 $PY experiments/arms/summarise.py --sensing full --seeds 42 \
   > results/arms/table_full_split_by_run_seed42.md
 # 5. (2026-11-26, after the split was fixed: a session recorded on several arms is one session)
@@ -49,9 +52,38 @@ $G --variants gbdt --seeds 42,43 --override model.severity=false --steps train,c
 $G --variants stgnn_fixed,anomaly_residual --seeds 42 --epochs 30 --steps train,commission,alarms
 $G --variants stgnn_fixed --seeds 43 --epochs 30 --arms ur3e --steps train,commission,alarms
 $G --variants anomaly_residual --seeds 43 --epochs 30 --arms ur5e --steps train,commission,alarms
-$PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_grouped \
-  > results/arms/table_full.md
 $PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_grouped --seeds 42 \
   > results/arms/table_full_seed42.md
+# 6. (2026-11-26, a later session) three seeds on the fixed split. The networks' missing seeds
+#    (full: seed 44, and 43 where step 5 lacks it) and the stock profile's stgnn_fixed, seeds
+#    42-44, as a job list:
+{ for a in ur5e ur10e ur16e; do echo "full loao $a stgnn_fixed 43"; done
+  for a in ur3e ur10e ur16e; do echo "full loao $a anomaly_residual 43"; done
+  for a in ur3e ur5e ur10e ur16e; do
+    echo "full loao $a stgnn_fixed 44"; echo "full loao $a anomaly_residual 44"; done
+  for s in 42 43 44; do for a in ur3e ur5e ur10e ur16e; do echo "stock loao $a stgnn_fixed $s"
+  done; done; } > outputs/jobs_grouped.txt
+#    trained on a lent GPU (one H200, 16 cores, CUDA MPS; the 26 trainings in 223 s, 352 s with
+#    the recording):
+#      CAMPAIGN=outputs/campaign_arms_grouped PAR=26 BUDGET_S=480 \
+#        experiments/arms/gpu_networks.sh outputs/jobs_grouped.txt
+#    its run directories unpacked here under outputs/campaign_arms_grouped; then, here:
+$G --variants stgnn_fixed,anomaly_residual --steps rescore,commission,alarms
+$G --variants stgnn_fixed --sensing stock --steps rescore,commission,alarms
+$G --variants gbdt --seeds 44 --override model.severity=false --steps train,commission
+mkdir -p outputs/campaign_arms_grouped/stock
+ln -sfn ../../campaign_arms/stock/own outputs/campaign_arms_grouped/stock/own
+$G --variants gbdt --seeds 42,43 --sensing stock --override model.severity=false \
+  --steps train,commission
+$C --out outputs/campaign_arms_grouped --stages own --variants gbdt --seeds 42 --sensing stock \
+  --override model.severity=false --steps train
+#    the stricter operating point (commission healthy_rate=0.99), every leave-one-arm-out model:
+$G --variants gbdt,stgnn_fixed,anomaly_residual --healthy-rate 0.99 --steps commission,alarms
+$PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_grouped \
+  > results/arms/table_full.md
+$PY experiments/arms/summarise.py --sensing stock --out outputs/campaign_arms_grouped \
+  > results/arms/table_stock.md
+$PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_grouped \
+  --healthy-rate 0.99 > results/arms/table_full_hr0.99.md
 $PY -m robohealth_mj.bench sim --duration 120 --arms ur5e,ur3e,ur10e,ur16e \
   > results/arms/bench_sim.txt
