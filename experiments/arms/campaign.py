@@ -72,7 +72,9 @@ def train(sweep: Path, train: list[str], heldout: str, args: argparse.Namespace,
 
 def runs(sweep: Path, variants: list[str]) -> list[Path]:
     """The sweep's runs of these variants (``.../<variant>/w<W>/seed<s>``)."""
-    found = (p.parent for p in sweep.rglob("best.ckpt") if p.parent.name != "commissioned")
+    found = (
+        p.parent for p in sweep.rglob("best.ckpt") if not p.parent.name.startswith("commissioned")
+    )
     return sorted(run for run in found if run.parts[-3] in variants)
 
 
