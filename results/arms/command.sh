@@ -73,7 +73,7 @@ $G --variants stgnn_fixed --sensing stock --steps rescore,commission,alarms
 $G --variants gbdt --seeds 44 --override model.severity=false --steps train,commission
 mkdir -p outputs/campaign_arms_grouped/stock
 ln -sfn ../../campaign_arms/stock/own outputs/campaign_arms_grouped/stock/own
-$G --variants gbdt --seeds 42,43 --sensing stock --override model.severity=false \
+$G --variants gbdt --seeds 42,43,44 --sensing stock --override model.severity=false \
   --steps train,commission
 $C --out outputs/campaign_arms_grouped --stages own --variants gbdt --seeds 42 --sensing stock \
   --override model.severity=false --steps train
