@@ -15,7 +15,7 @@
 # outputs/campaign_arms), BUDGET_S (seconds from this script's start after which the trainings are
 # stopped, so that the runs that finished are packed inside a lease), PACK (the archive,
 # outputs/campaign_arms_gpu.tgz). Start CUDA MPS first where the machine has it.
-set -uo pipefail
+set -euo pipefail
 PY=${PY:-python3}
 PAR=${PAR:-16}
 export CAMPAIGN=${CAMPAIGN:-outputs/campaign_arms}
@@ -38,6 +38,9 @@ for arm in ur5e ur10e ur3e ur16e; do
     '~corpus.healthy_hour' '~corpus.probe_payload_high' &
 done
 wait
+for arm in ur5e ur10e ur3e ur16e; do
+  [ -f "$CORPUS/$arm/corpus.json" ] || { echo "no corpus recorded for $arm" >&2; exit 1; }
+done
 # every training reads all of these: parse each once here rather than once per job
 ls "$CORPUS"/*/*/graphs.jsonl | xargs -P "$PAR" -I{} "$PY" -c \
   "from robohealth_mj.data.arrays import load_recordings; load_recordings(['{}'])"
@@ -47,6 +50,7 @@ mkdir -p outputs/gpu_logs
   timeout $((BUDGET_S - SECONDS)) xargs -P "$PAR" -L 1 sh -c '"$0" experiments/arms/campaign.py \
     --out "$CAMPAIGN" --steps train --epochs 30 --sensing "$1" --stages "$2" --arms "$3" \
     --variants "$4" --seeds "$5" > "outputs/gpu_logs/$1_$2_$3_$4_$5.log" 2>&1
-    echo "$1 $2 $3 $4 $5 rc=$?" >> outputs/gpu_logs/done.txt' "$PY"
-echo "trainings: exit $? after $SECONDS s"
+    echo "$1 $2 $3 $4 $5 rc=$?" >> outputs/gpu_logs/done.txt' "$PY" &&
+  echo "trainings done after $SECONDS s" ||
+  echo "trainings stopped (exit $?) after $SECONDS s: packing the runs that finished"
 tar -czf "$PACK" --exclude=tensorboard --exclude=.hydra "$CAMPAIGN" outputs/gpu_logs
