@@ -77,6 +77,10 @@ def main(argv: list[str] | None = None) -> None:
     ros2.add_argument(
         "--health-hz", type=float, default=20.0, help="each arm's /health_diagnosis rate"
     )
+    ros2.add_argument(
+        "--diagnose-wait-s", type=float, default=0.02,
+        help="how long a completed sample waits for the other arms' (ros2.diagnose_wait_s)",
+    )  # fmt: skip
     for p, seconds in ((streams, 30.0), (soak, 60.0)):
         p.add_argument("--model", default=headline)
         p.add_argument("--data", nargs="+", default=["outputs/corpus/standard/heldout_seed900"])
@@ -119,7 +123,7 @@ def main(argv: list[str] | None = None) -> None:
         from robohealth_mj.benchmarks.ros2 import bench_ros2
 
         bench_ros2(args.model, args.data, args.arms, args.seconds, args.layouts, args.monitors,
-                   args.health_hz)  # fmt: skip
+                   args.health_hz, args.diagnose_wait_s)  # fmt: skip
     elif args.what in ("streams", "soak"):
         from robohealth_mj.benchmarks.fleet import bench_fleet, bench_soak
         from robohealth_mj.common.errors import one_line_errors

@@ -309,8 +309,31 @@ def sample_from_messages(
         rows.append((a.x, a.y, a.z, *vib.data))
     if rows:  # every joint's acceleration and vibration channels, in one assignment
         sensor[:, _SENSOR_COLUMNS] = rows
-    x = node_features(joint_state, sensor).astype(np.float32)
+    return labelled_sample(t, node_features(joint_state, sensor).astype(np.float32), fault, where)
+
+
+def labelled_sample(t: float, x: np.ndarray, fault: Any | None, where) -> GraphSample:
+    """A GraphSample of features ``x [N_NODES, N_FEATURES]`` and ``fault_state``'s truth
+    (``None``: healthy, numbered 0)."""
     if fault is None:
         return GraphSample("", 0, t, x, FaultLabel(), dict(UNLABELLED_SEGMENT))
     label, index, segment, run_id = truth_from_status(fault, where)
     return GraphSample(run_id, index, t, x, label, segment)
+
+
+def message_values_layout() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where the per-sensor messages' numbers go in a sample's features, as
+    ``x = base.copy(); x.flat[dest] = values[src]``: ``values`` is each joint's position,
+    velocity, effort (joint states), position error and effort residual (tracking error), 6 x 5
+    joint by joint, then each joint's IMU acceleration x, y, z and five vibration values, 6 x 8
+    (absent without the sensor messages). Read off :func:`node_features`, so the two agree."""
+    n_state = N_JOINTS * (STATE_CHANNELS.stop - STATE_CHANNELS.start)
+    state = 2.0 + np.arange(n_state, dtype=np.float64).reshape(N_JOINTS, -1)
+    sensor = np.zeros((N_JOINTS, SENSOR_CHANNELS.stop - SENSOR_CHANNELS.start))
+    n_sensor = N_JOINTS * len(_SENSOR_COLUMNS)
+    sensor[:, _SENSOR_COLUMNS] = 2.0 + n_state + np.arange(n_sensor).reshape(N_JOINTS, -1)
+    base = node_features(np.zeros_like(state), np.zeros_like(sensor))
+    coded = node_features(state, sensor)
+    dest = np.flatnonzero(coded != base)
+    src = (coded.ravel()[dest] - 2.0).astype(np.intp)
+    return base.astype(np.float32), dest, src

@@ -53,11 +53,11 @@ def _publisher(
 
 def _monitor(
     domain: int, model: str, arms: list[str], seconds: float, layout: str, expected: int,
-    health_hz: float, ready, go, out,
+    health_hz: float, diagnose_wait_s: float, ready, go, out,
 ) -> None:  # fmt: skip
     """One monitor process: its share of the arms, until every sample came or time ran out."""
     from robohealth_mj.ros2.bus import Bus, BusConfig
-    from robohealth_mj.ros2.node import MonitorNode
+    from robohealth_mj.ros2.node import MonitorNode, poll_paced
     from robohealth_mj.runtime.runtime import ModelRuntime
 
     latencies: list[float] = []
@@ -67,14 +67,14 @@ def _monitor(
 
     bus = Bus(BusConfig(domain_id=domain, interface="127.0.0.1", depth=50))
     node = MonitorNode(bus, ModelRuntime(model), arms, on_diagnosis=on_diagnosis, layout=layout,
-                       health_diagnosis_hz=health_hz)  # fmt: skip
+                       health_diagnosis_hz=health_hz,
+                       diagnose_wait_s=diagnose_wait_s)  # fmt: skip
     ready.set()
     go.wait()
     cpu0, wall0 = time.process_time(), time.perf_counter()
     deadline = wall0 + seconds + 3.5
     while time.perf_counter() < deadline and sum(s.samples for s in node.arms.values()) < expected:
-        if not node.poll():
-            time.sleep(0.005)  # as the monitor's default poll_s
+        poll_paced(node, 0.005)  # as the monitor's default poll_s
     wall = time.perf_counter() - wall0
     out.put({
         "diagnosed": sum(s.samples for s in node.arms.values()),
@@ -88,7 +88,7 @@ def _monitor(
 
 def run_once(
     model: str, samples: list, arms: int, seconds: float, domain: int, layout: str,
-    monitors: int = 1, health_hz: float = 20.0,
+    monitors: int = 1, health_hz: float = 20.0, diagnose_wait_s: float = 0.02,
 ) -> dict[str, Any]:  # fmt: skip
     """Publishers in one child process; ``monitors`` monitor processes, each a stable-hash
     share of the arms (as ``ros2.partition=k/n`` splits them); CPU per side in cores."""
@@ -104,7 +104,8 @@ def run_once(
     for share in shares:
         ready = ctx.Event()
         children.append(ctx.Process(target=_monitor, args=(
-            domain, model, share, seconds, layout, ticks * len(share), health_hz, ready, go,
+            domain, model, share, seconds, layout, ticks * len(share), health_hz,
+            diagnose_wait_s, ready, go,
             results)))  # fmt: skip
         readies.append(ready)
     publisher_ready = ctx.Event()
@@ -147,7 +148,7 @@ def run_once(
 
 def bench_ros2(
     model: str, data: str, arms_list: list[int], seconds: float, layouts: list[str],
-    monitors: list[int] | None = None, health_hz: float = 20.0,
+    monitors: list[int] | None = None, health_hz: float = 20.0, diagnose_wait_s: float = 0.02,
 ) -> list[dict]:  # fmt: skip
     from robohealth_mj.data.arrays import resolve_recordings
     from robohealth_mj.data.read import read_samples
@@ -160,7 +161,8 @@ def bench_ros2(
         f"{'p99 ms':>7} {'monitor CPU':>11} {'publisher CPU':>13}   monitor time by phase"
     )
     for layout, n, arms in itertools.product(layouts, monitors or [1], arms_list):
-        r = run_once(model, samples, arms, seconds, next(domains), layout, n, health_hz)
+        r = run_once(model, samples, arms, seconds, next(domains), layout, n, health_hz,
+                     diagnose_wait_s)  # fmt: skip
         r["layout"] = layout
         rows.append(r)
         print(

@@ -18,6 +18,7 @@ reported missing (``late``).
 
 from __future__ import annotations
 
+import json
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -27,10 +28,13 @@ import numpy as np
 
 from robohealth_mj.bags.messages import (
     array_stamp_ns,
+    labelled_sample,
     sample_from_aggregated,
     sample_from_messages,
 )
 from robohealth_mj.bags.topics import BagTopics
+from robohealth_mj.ros2.cdr import MessageView, read, undecodable
+from robohealth_mj.ros2.templates import SampleGather, Template, template_of
 from robohealth_mj.schema import FEATURE_NAMES, JOINT_NAMES, NODE_NAMES, FaultLabel, GraphSample
 
 UNKNOWN_TRUTH = FaultLabel("none", None, 0.0, False)
@@ -42,6 +46,12 @@ class Assembled:
     problems: list[str] = field(default_factory=list)
     duplicates: int = 0  # repeated identical messages, dropped
     late: int = 0  # messages for ticks already reported missing, dropped
+
+    def extend(self, other: Assembled) -> None:
+        self.samples += other.samples
+        self.problems += other.problems
+        self.duplicates += other.duplicates
+        self.late += other.late
 
 
 def header_stamp_ns(msg: Any) -> int | None:
@@ -81,6 +91,16 @@ class ArmAssembler:
         if require_truth:
             self.stamped.append(topics.fault_state)
         self._stamped_set, self._every = frozenset(self.stamped), frozenset(self.topic_names())
+        self._n_every = len(self._every)
+        # what each topic's numbers are in a sample, for its byte template (per-sensor layouts)
+        self.roles = {topics.joint_states: "joint_states", topics.joint_errors: "joint_errors"}
+        self.roles |= {t: "imu" for t in self.imu} | {t: "vibration" for t in self.vibration}
+        self.roles[topics.fault_state] = "truth"
+        if aggregated:
+            self.roles[aggregated] = "aggregated"
+        self.templates: dict[str, Template | None] = {}
+        self.gather = SampleGather("aggregated" if aggregated else "per_sensor" if sensors
+                                   else "joints")  # fmt: skip
         self.pending: dict[int, dict[str, Any]] = {}
         self.queues: dict[str, deque] = {t: deque() for t in self.vibration}
         self.last_emitted: int | None = None
@@ -96,24 +116,64 @@ class ArmAssembler:
     def add(self, topic: str, msg: Any) -> Assembled:
         """Take one message; return the samples it completed and any problems."""
         out = Assembled()
-        if topic in self.queues and array_stamp_ns(msg) is None:
-            self.queues[topic].append(msg)
-        else:
-            headerless = topic in self.queues or topic == self.aggregated
-            stamp = array_stamp_ns(msg) if headerless else header_stamp_ns(msg)
-            if stamp is None:
-                out.problems.append(f"topic '{topic}': message without a header stamp")
-                return out
-            if self.last_emitted is not None and stamp <= self.last_emitted:
-                self._settled_message(topic, stamp, msg, out)
-                return out
-            slot = self.pending.setdefault(stamp, {})
-            if topic in slot:
-                self._repeated(topic, stamp, slot[topic], msg, out)
-                return out
-            slot[topic] = msg
-        self._drain(out, drop_late=False)
+        self._add(topic, msg, out)
         return out
+
+    def add_all(self, topic: str, messages: list[Any], out: Assembled) -> None:
+        """Take one topic's messages in order, into ``out`` (a reader's take at a time)."""
+        for msg in messages:
+            self._add(topic, msg, out)
+
+    def add_serialized(self, topic: str, kind: type, buffers: list[bytes], out: Assembled) -> None:
+        """Take one topic's messages as they came off the wire, into ``out``: a message of the
+        topic's byte template is kept as its bytes and stamp; any other is read in full (the
+        binding decides what that one is), and its layout becomes the topic's template."""
+        template = self.templates.get(topic)
+        for buf in buffers:
+            msg = template.view(buf) if template is not None else None
+            if msg is None:
+                try:
+                    msg = read(kind, buf)
+                except Exception as exc:  # a buffer no decoder reads is this arm's bad input
+                    out.problems.append(f"topic '{topic}': {undecodable(kind, exc)}")
+                    continue
+                if isinstance(msg, MessageView):
+                    template = template_of(msg, self.roles.get(topic, ""), self.joints)
+                    self.templates[topic] = msg.template = template
+            self._add(topic, msg, out)
+
+    def _stamp(self, topic: str, msg: Any) -> int | None:
+        if isinstance(msg, MessageView):  # read from the bytes with the rest of the view
+            return msg.stamp_ns
+        headerless = topic in self.queues or topic == self.aggregated
+        return array_stamp_ns(msg) if headerless else header_stamp_ns(msg)
+
+    def _add(self, topic: str, msg: Any, out: Assembled) -> None:
+        stamp = self._stamp(topic, msg)
+        if stamp is None and topic in self.queues:  # an array without a stamp: by arrival
+            self.queues[topic].append(msg)
+            self._drain(out, drop_late=False)
+            return
+        if stamp is None:
+            out.problems.append(f"topic '{topic}': message without a header stamp")
+            return
+        if self.last_emitted is not None and stamp <= self.last_emitted:
+            self._settled_message(topic, stamp, msg, out)
+            return
+        slot = self.pending.get(stamp)
+        if slot is None:
+            slot = self.pending[stamp] = {}
+        elif topic in slot:
+            self._repeated(topic, stamp, slot[topic], msg, out)
+            return
+        slot[topic] = msg
+        # Only a slot that is now complete (or arrays queued by arrival) can let a tick out:
+        # adding to an incomplete tick changes nothing older.
+        if len(slot) == self._n_every or self._queued():
+            self._drain(out, drop_late=False)
+
+    def _queued(self) -> bool:
+        return any(self.queues.values()) if self.queues else False
 
     def settle(self) -> Assembled:
         """At a poll boundary: report the ticks that stay incomplete while ``late_ticks`` newer
@@ -201,6 +261,29 @@ class ArmAssembler:
 
         truth = slot.get(self.topics.fault_state) if self.require_truth else None
         truth = truth if truth is not None else _NoTruth(self.arm, self.count)
+        if self.aggregated:
+            parts = [slot[self.aggregated]]
+        else:
+            parts = [slot[self.topics.joint_states], slot[self.topics.joint_errors]]
+            if self.sensors:
+                parts += [*(slot[t] for t in self.imu), *vibs]
+        if all(isinstance(m, MessageView) and m.template is not None for m in parts):
+            x = self.gather.features(parts)
+            if np.isfinite(x).all():  # else the full reading below names the bad field
+                if isinstance(truth, MessageView) and truth.template is not None:
+                    label, segment, run_id = truth.template.truth
+                    sample = GraphSample(run_id, truth.index, stamp / 1e9, x, label,
+                                         json.loads(segment))  # fmt: skip
+                else:
+                    try:
+                        sample = labelled_sample(stamp / 1e9, x, _in_full(truth), where)
+                    except (AttributeError, TypeError, ValueError) as exc:
+                        raise _Problem(f"{at}: malformed message ({exc})") from None
+                self.count += 1
+                return sample
+        # read what was kept as bytes, as the message path reads it
+        slot = {t: _in_full(m) for t, m in slot.items()}
+        vibs, truth = [_in_full(m) for m in vibs], _in_full(truth)
         try:
             if self.aggregated:
                 sample = sample_from_aggregated(stamp / 1e9, slot[self.aggregated], truth, where)
@@ -239,6 +322,13 @@ class ArmAssembler:
             return self.topics.joint_errors
         kind = self.topics.imu if feature.startswith("acc_") else self.topics.vibration
         return kind.format(joint=joint)
+
+
+def _in_full(msg: Any) -> Any:
+    """A message kept as its bytes and stamp, read in full (other messages as they are)."""
+    if isinstance(msg, MessageView) and msg.template is not None:
+        return read(msg.kind, msg.raw)
+    return msg
 
 
 class _NoTruth:

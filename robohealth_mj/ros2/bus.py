@@ -159,3 +159,43 @@ class Bus:
         self._topics.clear()
         self.participant = None
         self._domain = None
+
+
+class ReadySet:
+    """Which of many readers hold data, in one call: a DDS waitset of one read condition per
+    reader. A monitor of hundreds of readers (15 a per-sensor arm) then takes only from those
+    that have something, and waits in DDS, not in a sleep, until one has."""
+
+    def __init__(self, bus: Bus, readers: list[Any]) -> None:
+        import ctypes
+
+        from cyclonedds.core import (
+            DDSException,
+            InstanceState,
+            ReadCondition,
+            SampleState,
+            ViewState,
+            WaitSet,
+        )
+
+        self._waitset = WaitSet(bus.participant)
+        mask = SampleState.NotRead | ViewState.Any | InstanceState.Any
+        self._conditions = [ReadCondition(r, mask) for r in readers]
+        for k, condition in enumerate(self._conditions):
+            # the attach argument is what the wait reports: k + 1 (a 0 would read as None)
+            ret = self._waitset._waitset_attach(self._waitset._ref, condition._ref, k + 1)
+            if ret < 0:
+                raise DDSException(ret, f"Occurred when attaching reader {k} to a waitset")
+        self._triggered = (ctypes.c_void_p * max(1, len(readers)))()
+        self._out = ctypes.cast(self._triggered, ctypes.POINTER(ctypes.c_void_p))
+
+    def wait(self, timeout_s: float = 0.0) -> list[int]:
+        """The indices (in ``readers``' order) of the readers holding unread data, waiting up
+        to ``timeout_s`` for one when none does."""
+        from cyclonedds.core import DDSException
+
+        n = len(self._conditions)
+        got = self._waitset._waitset_wait(self._waitset._ref, self._out, n, int(timeout_s * 1e9))
+        if got < 0:
+            raise DDSException(got, "Occurred while waiting for readers")
+        return sorted(self._triggered[i] - 1 for i in range(min(got, n)))

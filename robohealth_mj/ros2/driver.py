@@ -150,6 +150,11 @@ class DriverAssembler:
         self._drain(out, settle=False)
         return out
 
+    def add_all(self, topic: str, messages: list[Any], out: Assembled) -> None:
+        """Take one topic's messages in order, into ``out``."""
+        for msg in messages:
+            out.extend(self.add(topic, msg))
+
     def settle(self) -> Assembled:
         """At a poll boundary: drop the ticks the silent controller cannot serve."""
         out = Assembled()

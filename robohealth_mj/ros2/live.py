@@ -102,7 +102,7 @@ def run_monitor(
     ``tracking``: the model reads the tracking error (``ur_driver``: await the controller)."""
     require_dds()
     from robohealth_mj.ros2.bus import Bus
-    from robohealth_mj.ros2.node import MonitorNode
+    from robohealth_mj.ros2.node import MonitorNode, poll_paced
 
     arms = arm_names(cfg)
     if not arms:
@@ -111,6 +111,7 @@ def run_monitor(
     node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
                        stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
                        health_diagnosis_hz=float(cfg.get("health_diagnosis_hz", 20.0)),
+                       diagnose_wait_s=float(cfg.get("diagnose_wait_s", 0.02)),
                        **layout_options(cfg, tracking))  # fmt: skip
     started = time.monotonic()
     last_report = started
@@ -122,8 +123,7 @@ def run_monitor(
                 now = time.monotonic()
                 if duration_s and now - started >= duration_s:
                     break
-                if not node.poll():  # nothing completed: wait a poll period (an empty poll of
-                    time.sleep(float(cfg.poll_s))  # every reader is not free)
+                poll_paced(node, float(cfg.poll_s))  # what arrived in a period, in one go
                 if now - last_report >= float(cfg.diagnostics_period_s):
                     node.publish_diagnostics(time.time())
                     for arm, problem in node.reported:  # as it happens, not only at the end

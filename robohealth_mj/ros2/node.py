@@ -21,7 +21,7 @@ from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.ros2 import layout_sensing
 from robohealth_mj.ros2.assembly import ArmAssembler, Assembled
-from robohealth_mj.ros2.bus import Bus
+from robohealth_mj.ros2.bus import Bus, ReadySet
 from robohealth_mj.ros2.cdr import decode_all, encode_diagnostic_array, take_raw
 from robohealth_mj.ros2.driver import DriverAssembler, DriverConfig, DriverMessages
 from robohealth_mj.ros2.idl import CONTROLLER_STATES, TYPES, IdlStore
@@ -85,6 +85,18 @@ def driver_topics(topics: BagTopics, arm: str, driver: DriverConfig, namespace: 
         topics.joint_states: TYPES["sensor_msgs/msg/JointState"],
         in_namespace(arm, driver.controller_state, namespace): CONTROLLER_STATES[driver.layout],
     }
+
+
+def poll_paced(node: MonitorNode, period_s: float) -> int:
+    """One poll of ``node``, then the rest of ``period_s``: what arrived meanwhile is taken in
+    one go and diagnosed in one runtime step (fewer, larger takes and steps: polling as fast as
+    messages trickle in would diagnose a few arms a step)."""
+    started = time.perf_counter()
+    done = node.poll()
+    rest = period_s - (time.perf_counter() - started)
+    if rest > 0:
+        time.sleep(rest)
+    return done
 
 
 class ArmPublisher:
@@ -182,16 +194,24 @@ class MonitorNode:
         namespace: str = "/{arm}",
         driver: DriverConfig | None = None,
         health_diagnosis_hz: float = 20.0,
+        diagnose_wait_s: float = 0.02,
     ) -> None:
         """``health_diagnosis_hz``: each arm's ``/health_diagnosis`` at most this often (every
         diagnosis at the 20 Hz tick; less saves the monitor's publishing time at many arms).
         ``joint_names`` (a preset of ``conf/joint_names.yaml`` or six names) and ``tf_prefix``
         (``{arm}`` is the arm's name) say what each arm's JointState messages call its joints;
-        ``namespace`` where its topics live; ``driver`` the UR driver's side (``ur_driver``)."""
+        ``namespace`` where its topics live; ``driver`` the UR driver's side (``ur_driver``).
+        ``diagnose_wait_s``: how long a completed sample may wait for the other arms' before
+        the runtime step (one step for the whole fleet's tick instead of a step per arm)."""
         self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
         if not health_diagnosis_hz > 0:
             raise InputError(f"ros2.health_diagnosis_hz must be > 0, got {health_diagnosis_hz}")
         self.health_every = max(1, round(20.0 / health_diagnosis_hz))  # every k-th diagnosis
+        if not diagnose_wait_s >= 0:
+            raise InputError(f"ros2.diagnose_wait_s must be >= 0, got {diagnose_wait_s}")
+        self.diagnose_wait_s = diagnose_wait_s
+        self._waiting: dict[str, list[GraphSample]] = {}  # completed, not yet diagnosed
+        self._waiting_since: float | None = None
         self.keep_diagnoses, self.on_diagnosis = keep_diagnoses, on_diagnosis
         # where the monitor's time goes (the benchmark reports it): take (the DDS take),
         # decode (CDR), assemble, diagnose (runtime), publish (the diagnoses' writes)
@@ -203,6 +223,7 @@ class MonitorNode:
         self.arms: dict[str, ArmState] = {}
         self.reported: list[tuple[str, str]] = []  # (arm, problem) of the last /diagnostics
         self.diagnosis_writers: dict[str, Any] = {}
+        self._taps: list[tuple[str, str, type, Any, bool]] = []  # every reader, arm by arm
         for arm in arms:
             names = arm_topics(arm, topics, namespace)
             joints = arm_joint_names(joint_names, tf_prefix.format(arm=arm))
@@ -218,41 +239,65 @@ class MonitorNode:
                                          joints=joints)  # fmt: skip
             readers = [(t, kinds[t], bus.reader(t, kinds[t])) for t in assembler.topic_names()]
             self.arms[arm] = ArmState(assembler, readers)
+            # the bag layouts' assembler reads the bytes (byte templates); the driver's, objects
+            raw = isinstance(assembler, ArmAssembler)
+            self._taps += [(arm, topic, kind, reader, raw) for topic, kind, reader in readers]
             self.diagnosis_writers[arm] = bus.writer(names.health_diagnosis, TYPES[
                 "diagnostic_msgs/msg/DiagnosticArray"])  # fmt: skip
         self.diagnostics = bus.writer(
             DIAGNOSTICS_TOPIC, TYPES["diagnostic_msgs/msg/DiagnosticArray"]
         )
+        self.ready = ReadySet(bus, [tap[3] for tap in self._taps])
 
-    def poll(self, max_per_reader: int = 256) -> int:
-        """Take what has arrived, diagnose the completed samples; returns how many."""
-        now = time.monotonic()
+    def poll(self, max_per_reader: int = 256, wait_s: float = 0.0) -> int:
+        """Take what has arrived (waiting up to ``wait_s`` for something when nothing has);
+        diagnose the completed samples once every arm has one, or once the oldest has waited
+        ``diagnose_wait_s``. Returns how many samples were diagnosed."""
         clock = time.perf_counter
+        ready = self.ready.wait(wait_s)  # the readers holding data, arm by arm
+        now = time.monotonic()
         submitted: list[tuple[str, GraphSample]] = []
-        for arm, state in self.arms.items():
-            for topic, kind, reader in state.readers:
-                t0 = clock()
-                raw = take_raw(reader, max_per_reader)
-                td = clock()
+        taken_by_arm: dict[str, Assembled] = {}
+        for index in ready:
+            arm, topic, kind, reader, serialized = self._taps[index]
+            state = self.arms[arm]
+            out = taken_by_arm.get(arm)
+            if out is None:
+                out = taken_by_arm[arm] = Assembled()
+            t0 = clock()
+            raw = take_raw(reader, max_per_reader)
+            t1 = clock()
+            self.seconds["take"] += t1 - t0
+            if serialized:  # decoding is part of assembly (only a changed layout is decoded)
+                state.assembler.add_serialized(topic, kind, raw, out)
+            else:
                 taken, undecodable = decode_all(kind, raw)
-                t1 = clock()
-                self.seconds["take"] += td - t0
-                self.seconds["decode"] += t1 - td
-                for problem in undecodable:
-                    self._collect(arm, state, Assembled(problems=[f"topic '{topic}': {problem}"]),
-                                  now, submitted)  # fmt: skip
-                for msg in taken:
-                    self._collect(arm, state, state.assembler.add(topic, msg), now, submitted)
-                self.seconds["assemble"] += clock() - t1
-            t1 = clock()  # every reader of the arm taken: now a missing message is missing
-            self._collect(arm, state, state.assembler.settle(), now, submitted)
+                td = clock()
+                self.seconds["decode"] += td - t1
+                t1 = td
+                out.problems += [f"topic '{topic}': {problem}" for problem in undecodable]
+                state.assembler.add_all(topic, taken, out)
             self.seconds["assemble"] += clock() - t1
+        t1 = clock()
+        for arm, out in taken_by_arm.items():
+            # every ready reader of the arm taken: now a missing message is missing (only an arm
+            # that received something can have a tick newly complete or newly overdue)
+            state = self.arms[arm]
+            out.extend(state.assembler.settle())
+            self._collect(arm, state, out, now, submitted)
+        self.seconds["assemble"] += clock() - t1
         t2 = clock()
+        for arm, sample in submitted:
+            self._waiting.setdefault(arm, []).append(sample)
+        if self._waiting and self._waiting_since is None:
+            self._waiting_since = now
+        if not self._waiting or (
+            len(self._waiting) < len(self.arms) and now - self._waiting_since < self.diagnose_wait_s
+        ):
+            return 0  # a runtime step costs about a millisecond whatever its size: fill it
+        by_arm, self._waiting, self._waiting_since = self._waiting, {}, None
         # One sample per arm per runtime step: every sample gets its own decision (a step given
         # several samples of one stream decides only the last), and the arms share each step.
-        by_arm: dict[str, list[GraphSample]] = {}
-        for arm, sample in submitted:
-            by_arm.setdefault(arm, []).append(sample)
         for round_ in range(max((len(v) for v in by_arm.values()), default=0)):
             queued = {}
             for arm, samples in by_arm.items():
@@ -267,7 +312,7 @@ class MonitorNode:
         self.seconds["diagnose"] += clock() - t2 - self._publishing
         self.seconds["publish"] += self._publishing
         self._publishing = 0.0
-        return len(submitted)
+        return sum(len(v) for v in by_arm.values())
 
     @staticmethod
     def _collect(arm: str, state: ArmState, got: Any, now: float, submitted: list) -> None:

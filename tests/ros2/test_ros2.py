@@ -289,6 +289,56 @@ def test_simulated_arms_on_loopback_are_diagnosed_and_reported_on_diagnostics(de
         bus.close()
 
 
+def test_the_ready_set_names_the_readers_holding_data_and_only_those():
+    from robohealth_mj.ros2.bus import ReadySet
+    from robohealth_mj.ros2.cdr import take_raw
+    from robohealth_mj.ros2.idl import JointState
+
+    config = _bus()
+    robot, monitor = Bus(config), Bus(config)
+    readers = [monitor.reader(f"/r{k}/joint_states", JointState) for k in range(4)]
+    writers = [robot.writer(f"/r{k}/joint_states", JointState) for k in range(4)]
+    ready = ReadySet(monitor, readers)
+    time.sleep(0.5)  # discovery on loopback
+    assert ready.wait(0.0) == []
+    for k in (1, 3):
+        writers[k].write(JointState(name=["a"], position=[float(k)], velocity=[], effort=[]))
+    deadline = time.monotonic() + 10
+    got: list[int] = []
+    while time.monotonic() < deadline and got != [1, 3]:
+        got = ready.wait(0.5)
+    assert got == [1, 3]
+    assert [len(take_raw(readers[k], 16)) for k in got] == [1, 1]
+    assert ready.wait(0.0) == []  # taken: nothing is ready any more
+
+
+def test_a_completed_sample_waits_for_the_other_arms_and_one_step_diagnoses_them(deployed):
+    """The monitor steps the runtime once a tick has every arm's sample (or once the oldest
+    waited ``diagnose_wait_s``), not once per arm as their messages trickle in."""
+    config = _bus()
+    robot, monitor = Bus(config), Bus(config)
+    samples = list(itertools.islice(read_samples(deployed["heldout"]), 3))
+    runtime = ModelRuntime(deployed["structural_onnx"])
+    node = MonitorNode(monitor, runtime, ["arm1", "arm2"], diagnose_wait_s=60.0)
+    arms = {a: ArmPublisher(robot, a) for a in ("arm1", "arm2")}
+    time.sleep(0.5)  # discovery on loopback
+    for s in samples:
+        arms["arm1"].publish(s)
+    deadline = time.monotonic() + 3
+    while time.monotonic() < deadline:
+        assert node.poll() == 0  # arm2's samples are not in, and 60 s have not passed
+        time.sleep(0.01)
+    assert len(node._waiting["arm1"]) == 3 and node.arms["arm1"].samples == 0
+    for s in samples:
+        arms["arm2"].publish(s)
+    _spin(node, lambda: node.arms["arm2"].samples >= 3)
+    assert node.arms["arm1"].samples == node.arms["arm2"].samples == 3
+    node.diagnose_wait_s = 0.0  # an arm alone is diagnosed at once
+    arms["arm1"].publish(next(itertools.islice(read_samples(deployed["heldout"]), 3, None)))
+    _spin(node, lambda: node.arms["arm1"].samples >= 4)
+    assert node.arms["arm1"].samples == 4 and node.arms["arm2"].samples == 3
+
+
 def test_two_monitor_processes_split_four_arms_and_stop_cleanly_on_sigterm(deployed, tmp_path):
     """The command line end to end: a simulated robot process replays four arms; two monitor
     processes share them by hash partition (no arm diagnosed twice, none left out, every sample

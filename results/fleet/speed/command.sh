@@ -5,7 +5,7 @@
 #   BEFORE=4ecece7 bash results/fleet/speed/command.sh
 # Outputs: results/fleet/speed (the fleet step, decisions), results/ros2/speed (live over DDS).
 set -euo pipefail
-PY=$(realpath "${PY:-.venv/bin/python}")
+PY=${PY:-$PWD/.venv/bin/python}  # the venv's own (realpath would resolve it to the base interpreter)
 BEFORE=${BEFORE:-4ecece7}
 OUT=results/fleet/speed
 LIVE=results/ros2/speed  # the live path's outputs
