@@ -15,7 +15,9 @@
 #      recorder per arm;
 #   5. the leave-one-arm-out models again on the fixed split, seed 42;
 #   6. three seeds on the fixed split, the stock profile with gbdt, and the stricter operating
-#      point (results/arms/table_full.md, table_stock.md, table_full_hr0.99.md).
+#      point (results/arms/table_full.md, table_stock.md, table_full_hr0.99.md);
+#   7. (2026-11-27) gbdt's own models at seeds 43-44 on the UR5e, UR10e and UR16e (the UR3e had
+#      them), and the full-sensing tables again.
 # The 10-epoch campaign of 2026-11-25 (own models seed 42, networks 10 epochs, full sensing) is
 # results/arms/table_full_e10.md; its relative-channel ablation results/arms/raw_channels.md.
 set -euo pipefail
@@ -87,3 +89,10 @@ $PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_gro
   --healthy-rate 0.99 > results/arms/table_full_hr0.99.md
 $PY -m robohealth_mj.bench sim --duration 120 --arms ur5e,ur3e,ur10e,ur16e \
   > results/arms/bench_sim.txt
+# 7. gbdt's own models, seeds 43-44, on the three arms that had seed 42 alone (full sensing)
+$C --variants gbdt --seeds 43,44 --override model.severity=false --stages own --steps train \
+  --arms ur10e,ur16e,ur5e
+$PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_grouped \
+  > results/arms/table_full.md
+$PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_grouped \
+  --healthy-rate 0.99 > results/arms/table_full_hr0.99.md

@@ -34,5 +34,5 @@ for w in 0 0.01 0.02 0.04; do
   echo "# diagnose_wait_s=$w"
   run_after ros2 --model $M --data $D --arms 25 50 --layouts per_sensor --diagnose-wait-s $w
 done > $LIVE/diagnose_wait.txt
-# decode and assembly alone (no DDS), the message path against the byte path; a diagnosis's bytes
-$PY experiments/ros2/assembly_cost.py --data $D > $LIVE/assembly_cost.txt
+# the monitor's work alone (no DDS): decode and assembly by path, a runtime step by batch size
+$PY experiments/ros2/monitor_costs.py --data $D --model $M > $LIVE/monitor_costs.txt

@@ -1,8 +1,9 @@
-"""What one per-sensor message costs the monitor to decode and assemble, alone (no DDS): the
-message path (every message decoded into the binding's objects) against the byte path
-(templates, one gather a tick), on the same serialised ticks; and one diagnosis's encoding.
+"""What the monitor's own work costs, alone (no DDS): decoding and assembling one per-sensor
+message, the message path (every message decoded into the binding's objects) against the byte
+path (templates, one gather a tick) on the same serialised ticks; a runtime step per sample at
+each batch size; one diagnosis's encoding.
 
-    python experiments/ros2/assembly_cost.py --data DIR [--ticks 400] [--rounds 3]
+    python experiments/ros2/monitor_costs.py --data DIR --model M.onnx [--ticks 400] [--rounds 3]
 
 Both paths must give the same samples (checked here too; ``tests/ros2/test_templates.py`` holds
 it on every layout change and on bad messages).
@@ -21,6 +22,7 @@ from robohealth_mj.ros2.assembly import ArmAssembler, Assembled
 from robohealth_mj.ros2.cdr import decode, encode_diagnostic_array
 from robohealth_mj.ros2.idl import TYPES, IdlStore
 from robohealth_mj.ros2.node import arm_topics, layout_topics
+from robohealth_mj.runtime.runtime import ModelRuntime
 
 
 def assemble(ticks: list, serialized: bool) -> tuple[float, list]:
@@ -39,9 +41,29 @@ def assemble(ticks: list, serialized: bool) -> tuple[float, list]:
     return time.perf_counter() - started, samples
 
 
+def step_cost(model: str, samples: list, batch: int, arms: int = 50, ticks: int = 80) -> float:
+    """Microseconds a sample of ``ModelRuntime.tick`` when each step diagnoses ``batch`` arms
+    (after the windows fill)."""
+    runtime, names = ModelRuntime(model), [f"arm{k}" for k in range(arms)]
+    seconds, counted = 0.0, 0
+    for tick in range(ticks):
+        base = samples[tick % len(samples)]
+        for start in range(0, arms, batch):
+            for arm in names[start : start + batch]:
+                runtime.submit(arm, base.__class__("b", tick, tick / 20, base.x, base.fault,
+                                                   base.segment))  # fmt: skip
+            started = time.perf_counter()
+            runtime.tick()
+            if tick >= ticks // 2:
+                seconds += time.perf_counter() - started
+                counted += len(names[start : start + batch])
+    return seconds / counted * 1e6
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data", required=True, help="a recording to serialise")
+    parser.add_argument("--model", required=True, help="an exported model.onnx")
     parser.add_argument("--ticks", type=int, default=400)
     parser.add_argument("--rounds", type=int, default=3)
     args = parser.parse_args()
@@ -80,6 +102,9 @@ def main() -> None:
     for _ in range(n):
         encode_diagnostic_array(1_700_000_000_123_456_789, "", status)
     print(f"  one diagnosis encoded as bytes: {(time.perf_counter() - started) / n * 1e6:.1f} us")
+    for batch in (1, 5, 10, 25, 50):
+        cost = step_cost(args.model, samples, batch)
+        print(f"  a runtime step diagnosing {batch:>2} arms: {cost:.0f} us a sample")
 
 
 if __name__ == "__main__":
