@@ -16,8 +16,8 @@
 #   5. the leave-one-arm-out models again on the fixed split, seed 42;
 #   6. three seeds on the fixed split, the stock profile with gbdt, and the stricter operating
 #      point (results/arms/table_full.md, table_stock.md, table_full_hr0.99.md);
-#   7. (2026-11-27) gbdt's own models at seeds 43-44 on the UR5e, UR10e and UR16e (the UR3e had
-#      them), and the full-sensing tables again.
+#   7. (2026-11-27) gbdt's own models at seeds 43-44: full sensing on the UR5e, UR10e and UR16e
+#      (the UR3e had them), the stock profile on every arm; the tables again.
 # The 10-epoch campaign of 2026-11-25 (own models seed 42, networks 10 epochs, full sensing) is
 # results/arms/table_full_e10.md; its relative-channel ablation results/arms/raw_channels.md.
 set -euo pipefail
@@ -96,3 +96,8 @@ $PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_gro
   > results/arms/table_full.md
 $PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_grouped \
   --healthy-rate 0.99 > results/arms/table_full_hr0.99.md
+# 7b. gbdt's own models in the stock profile, seeds 43-44 (they had seed 42 alone)
+$C --out outputs/campaign_arms_grouped --stages own --variants gbdt --seeds 43,44 --sensing stock \
+  --override model.severity=false --steps train
+$PY experiments/arms/summarise.py --sensing stock --out outputs/campaign_arms_grouped \
+  > results/arms/table_stock.md
