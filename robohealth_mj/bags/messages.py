@@ -226,11 +226,16 @@ def array_stamp_ns(msg: Any) -> int | None:
     """The stamp a vibration array carries in its layout (see ``sample_messages``), if any."""
     for dim in getattr(getattr(msg, "layout", None), "dim", ()):
         if dim.label.startswith(STAMP_LABEL):
-            try:
-                return int(dim.label[len(STAMP_LABEL) :])
-            except ValueError:
-                return None
+            return label_stamp_ns(dim.label)
     return None
+
+
+def label_stamp_ns(label: str) -> int | None:
+    """The stamp of a ``stamp_ns=…`` dimension label (``None``: its digits are not a number)."""
+    try:
+        return int(label[len(STAMP_LABEL) :])
+    except ValueError:
+        return None
 
 
 def truth_from_status(fault: Any, where) -> tuple[FaultLabel, int, dict, str]:

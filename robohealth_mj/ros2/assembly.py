@@ -248,8 +248,6 @@ class ArmAssembler:
             )
 
     def _sample(self, stamp: int, slot: dict[str, Any], vibs: list[Any]) -> GraphSample:
-        at = f"at stamp {stamp / 1e9:.6f} s"
-
         def where(key, message: str) -> _Problem:
             if key == "aggregated":
                 topic = self.aggregated
@@ -257,7 +255,7 @@ class ArmAssembler:
                 topic = (
                     getattr(self.topics, key) if isinstance(key, str) else self.vibration[key[1]]
                 )
-            return _Problem(f"topic '{topic}' {at}: {message}")
+            return _Problem(f"topic '{topic}' {_at(stamp)}: {message}")
 
         truth = slot.get(self.topics.fault_state) if self.require_truth else None
         truth = truth if truth is not None else _NoTruth(self.arm, self.count)
@@ -278,7 +276,7 @@ class ArmAssembler:
                     try:
                         sample = labelled_sample(stamp / 1e9, x, _in_full(truth), where)
                     except (AttributeError, TypeError, ValueError) as exc:
-                        raise _Problem(f"{at}: malformed message ({exc})") from None
+                        raise _Problem(f"{_at(stamp)}: malformed message ({exc})") from None
                 self.count += 1
                 return sample
         # read what was kept as bytes, as the message path reads it
@@ -299,13 +297,14 @@ class ArmAssembler:
                     self.joints,
                 )
         except (AttributeError, TypeError, ValueError) as exc:
-            raise _Problem(f"{at}: malformed message ({exc})") from None
+            raise _Problem(f"{_at(stamp)}: malformed message ({exc})") from None
         bad = np.argwhere(~np.isfinite(sample.x))
         if bad.size:
             node, feat = bad[0]
             topic = self._topic_of(int(node), FEATURE_NAMES[feat])
             raise _Problem(
-                f"topic '{topic}' {at}: NaN or Inf in x[{NODE_NAMES[node]}].{FEATURE_NAMES[feat]}"
+                f"topic '{topic}' {_at(stamp)}: NaN or Inf in x[{NODE_NAMES[node]}]."
+                f"{FEATURE_NAMES[feat]}"
             )
         self.count += 1
         return sample
@@ -322,6 +321,11 @@ class ArmAssembler:
             return self.topics.joint_errors
         kind = self.topics.imu if feature.startswith("acc_") else self.topics.vibration
         return kind.format(joint=joint)
+
+
+def _at(stamp: int) -> str:
+    """Where a problem is, in time (made only for a problem: not on every sample)."""
+    return f"at stamp {stamp / 1e9:.6f} s"
 
 
 def _in_full(msg: Any) -> Any:

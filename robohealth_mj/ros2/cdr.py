@@ -22,7 +22,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from robohealth_mj.bags.messages import STAMP_LABEL
+from robohealth_mj.bags.messages import STAMP_LABEL, label_stamp_ns
 from robohealth_mj.ros2.idl import (
     DiagnosticArray,
     DiagnosticStatus,
@@ -318,6 +318,12 @@ def _stamp(sec: int, nanosec: int) -> int:
     return sec * 1_000_000_000 + nanosec
 
 
+def stamp_ns_at(buf: bytes, at: int = 4) -> int:
+    """The stamp (ns) of the header whose ``sec, nanosec`` start at ``at`` in ``buf``."""
+    sec, nanosec = _STAMP(buf, at)
+    return sec * 1_000_000_000 + nanosec
+
+
 _HEADER_STAMP = (4, 12)  # sec, nanosec: the first field of a header
 
 
@@ -341,11 +347,9 @@ def _array_view(buf: bytes) -> ArrayView:
     stamp = stamp_at = None
     for label, _, _, end in dims:  # as bags.messages.array_stamp_ns reads the message
         if label.startswith(STAMP_LABEL):
-            try:
-                stamp = int(label[len(STAMP_LABEL) :])
-            except ValueError:
-                break
-            stamp_at = (end - len(label.encode()) + len(STAMP_LABEL), end)
+            stamp = label_stamp_ns(label)
+            if stamp is not None:
+                stamp_at = (end - len(label.encode()) + len(STAMP_LABEL), end)
             break
     view = ArrayView(buf, stamp, stamp_at, ((start, len(data)),))
     view.data = data

@@ -249,12 +249,11 @@ class MonitorNode:
         )
         self.ready = ReadySet(bus, [tap[3] for tap in self._taps])
 
-    def poll(self, max_per_reader: int = 256, wait_s: float = 0.0) -> int:
-        """Take what has arrived (waiting up to ``wait_s`` for something when nothing has);
-        diagnose the completed samples once every arm has one, or once the oldest has waited
-        ``diagnose_wait_s``. Returns how many samples were diagnosed."""
+    def poll(self, max_per_reader: int = 256) -> int:
+        """Take what has arrived; diagnose the completed samples once every arm has one, or
+        once the oldest has waited ``diagnose_wait_s``. Returns how many were diagnosed."""
         clock = time.perf_counter
-        ready = self.ready.wait(wait_s)  # the readers holding data, arm by arm
+        ready = self.ready.wait()  # the readers holding data, arm by arm
         now = time.monotonic()
         submitted: list[tuple[str, GraphSample]] = []
         taken_by_arm: dict[str, Assembled] = {}

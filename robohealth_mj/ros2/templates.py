@@ -15,7 +15,6 @@ layout change and on damaged messages.
 
 from __future__ import annotations
 
-import struct
 from collections.abc import Sequence
 
 import numpy as np
@@ -23,10 +22,16 @@ import numpy as np
 from robohealth_mj.bags.joints import joint_order
 from robohealth_mj.bags.messages import message_values_layout, truth_from_status
 from robohealth_mj.bags.topics import VIBRATION_FIELDS
-from robohealth_mj.ros2.cdr import ArrayView, DiagnosticsView, ImuView, JointStateView, MessageView
+from robohealth_mj.ros2.cdr import (
+    ArrayView,
+    DiagnosticsView,
+    ImuView,
+    JointStateView,
+    MessageView,
+    stamp_ns_at,
+)
 from robohealth_mj.schema import N_FEATURES, N_JOINTS, N_NODES, STATE_FEATURES, FaultLabel
 
-_STAMP = struct.Struct("<iI").unpack_from  # a header's stamp: sec, nanosec
 _IMU_ACCELERATION = np.arange(25, 28)  # linear acceleration among an IMU message's 37 doubles
 _DOUBLE_BYTES = np.arange(8)
 _NO_OFFSETS = np.zeros(0, np.intp)
@@ -79,8 +84,7 @@ class Template:
             except ValueError:
                 return None  # read in full: the stamp is then what that reading says
         else:
-            sec, nanosec = _STAMP(buf, stamp_at[0])
-            stamp = sec * 1_000_000_000 + nanosec
+            stamp = stamp_ns_at(buf, stamp_at[0])
         view = self.cls.__new__(self.cls)
         if self.index_at is not None:
             try:
