@@ -6,7 +6,8 @@ commissioning, and false alarms on the unseen arm's healthy hour.
         [--steps train,rescore,commission,alarms] [--healthy-rate 0.99]
 
 Reads the per-arm corpora ``outputs/corpus/arms/<arm>`` (``python -m robohealth_mj.corpus
-corpus=arms ...``, see ``results/arms/command.sh``) and writes under ``outputs/campaign_arms``:
+corpus=arms ...``, see ``results/arms/command.sh``; ``--corpus`` names another root, e.g. one
+with more training sessions per arm) and writes under ``outputs/campaign_arms``:
 
 - ``own/<arm>/...``: each arm's own models (trained on its sessions, scored on its held-out one);
 - ``loao/<arm>/...``: models trained with ``transfer=true`` on the three other arms, scored on
@@ -49,7 +50,7 @@ def run(*args: str) -> None:
     subprocess.run([sys.executable, "-m", *args], check=True)
 
 
-def train(sweep: Path, train: list[str], heldout: str, args: argparse.Namespace, *extra: str):
+def train(sweep: Path, train: list[str], heldout: Path, args: argparse.Namespace, *extra: str):
     run(
         "robohealth_mj.train",
         "-m",
@@ -78,13 +79,13 @@ def runs(sweep: Path, variants: list[str]) -> list[Path]:
     return sorted(run for run in found if run.parts[-3] in variants)
 
 
-def rescore(run_dir: Path, arm: str) -> None:
+def rescore(run_dir: Path, arm: Path) -> None:
     """Score ``run_dir`` again on this machine's recording of ``arm``'s held-out session when it
     was scored on another (a run trained on a lent GPU, whose corpus was recorded there from the
     same seeds: another numpy can move the physics in its last bits), so that every column of the
     table reads one recording; the trainer's own score is kept as ``eval_heldout_trained``."""
     scored = json.loads((run_dir / "eval_heldout.json").read_text())["data_fingerprint"]
-    if scored == heldout_fingerprint(arm):
+    if scored == heldout_fingerprint(arm / "heldout_seed900"):
         return
     for ext in ("json", "csv"):
         kept = run_dir / f"eval_heldout_trained.{ext}"
@@ -94,8 +95,8 @@ def rescore(run_dir: Path, arm: str) -> None:
 
 
 @cache
-def heldout_fingerprint(arm: str) -> str:
-    return load_recordings(expand_paths([str(CORPUS / arm / "heldout_seed900")])).fingerprint()
+def heldout_fingerprint(session: Path) -> str:
+    return load_recordings(expand_paths([str(session)])).fingerprint()
 
 
 def commissioned_dir(run_dir: Path, healthy_rate: float | None = None) -> Path:
@@ -106,26 +107,26 @@ def commissioned_dir(run_dir: Path, healthy_rate: float | None = None) -> Path:
     )
 
 
-def commission_and_score(run_dir: Path, arm: str, healthy_rate: float | None = None) -> None:
+def commission_and_score(run_dir: Path, arm: Path, healthy_rate: float | None = None) -> None:
     """Commission ``run_dir``'s model on ``arm``'s healthy ten minutes and score it on ``arm``'s
     held-out session."""
     done = commissioned_dir(run_dir, healthy_rate)
     rate = [] if healthy_rate is None else [f"healthy_rate={healthy_rate:g}"]
     if not (done / "best.ckpt").is_file():
         run("robohealth_mj.commission", f"model={run_dir / 'best.ckpt'}",
-            f"healthy={CORPUS / arm / 'healthy_commissioning_seed940'}", f"out={done}",
+            f"healthy={arm / 'healthy_commissioning_seed940'}", f"out={done}",
             *rate)  # fmt: skip
     if not (done / "eval_heldout.json").is_file():
         score(done, arm)
 
 
-def score(run_dir: Path, arm: str) -> None:
+def score(run_dir: Path, arm: Path) -> None:
     """``run_dir``'s checkpoint on ``arm``'s held-out session, as ``eval_heldout.json``."""
     run("robohealth_mj.evaluate", f"ckpt={run_dir / 'best.ckpt'}",
-        f"data={CORPUS / arm / 'heldout_seed900'}", f"out={run_dir / 'eval_heldout'}")  # fmt: skip
+        f"data={arm / 'heldout_seed900'}", f"out={run_dir / 'eval_heldout'}")  # fmt: skip
 
 
-def healthy_alarms(done: Path, arm: str) -> None:
+def healthy_alarms(done: Path, arm: Path) -> None:
     """The commissioned network's alarms over ``arm``'s healthy hour under the monitor's default
     alarm and evidence policies (``conf/monitor.yaml``): the fleet runtime's decisions over the
     three sessions at once, then the monitor's alarm bank and on-line evaluator
@@ -136,8 +137,8 @@ def healthy_alarms(done: Path, arm: str) -> None:
         return
     cfg = load_config([])
     policy, evidence = AlarmPolicy(**cfg.alarm), EvidencePolicy(**cfg.evidence)
-    files = [CORPUS / arm / session / "graphs.jsonl" for session in todo]
-    print(f"+ alarms of {done} over {arm}'s {', '.join(todo)}", flush=True)
+    files = [arm / session / "graphs.jsonl" for session in todo]
+    print(f"+ alarms of {done} over {arm.name}'s {', '.join(todo)}", flush=True)
     for session, file, decisions in zip(
         todo, files, replay_many(done / "model.onnx", files), strict=True
     ):
@@ -170,6 +171,12 @@ def main() -> None:
         "--out", type=Path, default=OUT, help="campaign root (a variant recipe's own)"
     )
     parser.add_argument(
+        "--corpus",
+        type=Path,
+        default=CORPUS,
+        help="root of the per-arm corpora (<root>/<arm>/train_*, heldout_seed900, ...)",
+    )
+    parser.add_argument(
         "--healthy-rate",
         type=float,
         help="commission at this healthy rate (e.g. 0.99) into commissioned_hr<R>/ "
@@ -177,35 +184,36 @@ def main() -> None:
     )
     args = parser.parse_args()
     arms = args.arms.split(",")
-    missing = [a for a in arms if not (CORPUS / a / "corpus.json").is_file()]
+    root: Path = args.corpus
+    missing = [a for a in arms if not (root / a / "corpus.json").is_file()]
     if missing:
         raise SystemExit(
             f"no corpus for {', '.join(missing)}: python -m robohealth_mj.corpus corpus=arms "
-            f"out_dir={CORPUS}/<arm> 'record_overrides=[\"arm=<arm>\"]' (results/arms/command.sh)"
+            f"out_dir={root}/<arm> 'record_overrides=[\"arm=<arm>\"]' (results/arms/command.sh)"
         )
     stages, steps = args.stages.split(","), args.steps.split(",")
     variants = args.variants.split(",")
     for arm in arms:
-        heldout = str(CORPUS / arm / "heldout_seed900")
+        heldout = root / arm / "heldout_seed900"
         own = args.out / args.sensing / "own" / arm
         if "own" in stages and "train" in steps:
-            train(own, [f"{CORPUS}/{arm}/train_*"], heldout, args)
+            train(own, [f"{root}/{arm}/train_*"], heldout, args)
         if "own" in stages and "rescore" in steps:
             for run_dir in runs(own, variants):
-                rescore(run_dir, arm)
+                rescore(run_dir, root / arm)
         if "loao" in stages:
-            others = [f"{CORPUS}/{a}/train_*" for a in ARMS if a != arm]
+            others = [f"{root}/{a}/train_*" for a in ARMS if a != arm]
             sweep = args.out / args.sensing / "loao" / arm
             if "train" in steps:
                 train(sweep, others, heldout, args, "transfer=true")
             for run_dir in runs(sweep, variants):
                 if "rescore" in steps:
-                    rescore(run_dir, arm)
+                    rescore(run_dir, root / arm)
                 done = commissioned_dir(run_dir, args.healthy_rate)
                 if "commission" in steps:
-                    commission_and_score(run_dir, arm, args.healthy_rate)
+                    commission_and_score(run_dir, root / arm, args.healthy_rate)
                 if "alarms" in steps and (done / "model.onnx").is_file():
-                    healthy_alarms(done, arm)  # networks: a streaming runtime
+                    healthy_alarms(done, root / arm)  # networks: a streaming runtime
 
 
 if __name__ == "__main__":

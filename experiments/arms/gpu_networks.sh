@@ -14,14 +14,17 @@
 # Environment: PY (python), PAR (jobs at a time, 16), CAMPAIGN (campaign root,
 # outputs/campaign_arms), BUDGET_S (seconds from this script's start after which the trainings are
 # stopped, so that the runs that finished are packed inside a lease), PACK (the archive,
-# outputs/campaign_arms_gpu.tgz). Start CUDA MPS first where the machine has it.
+# outputs/campaign_arms_gpu.tgz), CORPUS (the per-arm corpora's root, outputs/corpus/arms),
+# CORPUS_OVERRIDES (more corpus overrides, space-separated, e.g. corpus.train.sessions=16 for twice
+# the training sessions per arm). Start CUDA MPS first where the machine has it.
 set -euo pipefail
 PY=${PY:-python3}
 PAR=${PAR:-16}
 export CAMPAIGN=${CAMPAIGN:-outputs/campaign_arms}
 BUDGET_S=${BUDGET_S:-3600}
 PACK=${PACK:-outputs/campaign_arms_gpu.tgz}
-CORPUS=outputs/corpus/arms
+export CORPUS=${CORPUS:-outputs/corpus/arms}
+read -r -a MORE <<< "${CORPUS_OVERRIDES:-}"
 
 all_jobs() {
   for sensing in full stock; do
@@ -35,7 +38,7 @@ all_jobs() {
 for arm in ur5e ur10e ur3e ur16e; do
   $PY -m robohealth_mj.corpus corpus=arms out_dir="$CORPUS/$arm" \
     "record_overrides=[\"arm=$arm\"]" progress=false jobs=4 '~corpus.healthy_commissioning' \
-    '~corpus.healthy_hour' '~corpus.probe_payload_high' &
+    '~corpus.healthy_hour' '~corpus.probe_payload_high' ${MORE[@]+"${MORE[@]}"} &
 done
 wait
 for arm in ur5e ur10e ur3e ur16e; do
@@ -48,8 +51,8 @@ echo "corpora parsed after $SECONDS s"
 mkdir -p outputs/gpu_logs
 { if [ $# -ge 1 ]; then cat "$1"; else all_jobs; fi; } |
   timeout $((BUDGET_S - SECONDS)) xargs -P "$PAR" -L 1 sh -c '"$0" experiments/arms/campaign.py \
-    --out "$CAMPAIGN" --steps train --epochs 30 --sensing "$1" --stages "$2" --arms "$3" \
-    --variants "$4" --seeds "$5" > "outputs/gpu_logs/$1_$2_$3_$4_$5.log" 2>&1
+    --out "$CAMPAIGN" --corpus "$CORPUS" --steps train --epochs 30 --sensing "$1" --stages "$2" \
+    --arms "$3" --variants "$4" --seeds "$5" > "outputs/gpu_logs/$1_$2_$3_$4_$5.log" 2>&1
     echo "$1 $2 $3 $4 $5 rc=$?" >> outputs/gpu_logs/done.txt' "$PY" &&
   echo "trainings done after $SECONDS s" ||
   echo "trainings stopped (exit $?) after $SECONDS s: packing the runs that finished"

@@ -1,7 +1,7 @@
 """The cross-arm table from the campaign's evaluations (``experiments/arms/campaign.py``).
 
     python experiments/arms/summarise.py [--sensing full] [--out DIR] [--seeds 42]
-        [--healthy-rate 0.99]
+        [--healthy-rate 0.99] [--against DIR]
 
 One row per held-out arm and variant: the arm's own model; the leave-one-arm-out model (trained
 with ``transfer=true`` on the three other arms) before and after commissioning on ten minutes
@@ -11,6 +11,8 @@ Then each network against ``gbdt`` after commissioning: ahead when the differenc
 exceeds the larger seed std. Also writes ``results/arms/results_<sensing>.csv`` (for another
 ``--out``, ``results_<its name>_<sensing>.csv``). ``--healthy-rate R`` reads the models
 commissioned at that healthy rate (``campaign.py --healthy-rate R``) in place of validation's.
+``--against DIR`` adds each model beside the same model of another campaign root (e.g. one
+trained on fewer sessions per arm): what the recipe changed, per arm, variant and stage.
 """
 
 from __future__ import annotations
@@ -172,6 +174,34 @@ def verdict(table: dict, sensing: str, baseline: str = "gbdt") -> str:
     return "\n".join(lines) + "\n"
 
 
+def against(table: dict, base: dict, sensing: str, base_name: str) -> str:
+    """Each model of this campaign beside the same model of ``base`` (another recipe): its
+    own model on its held-out session, and the leave-one-arm-out model after commissioning."""
+    lines = heading(
+        f"This campaign against `{base_name}`, sensing = {sensing} (held-out session; seeds)",
+        ["arm", "variant", "stage", f"{base_name} acc.", f"{base_name} loc.", "this acc.",
+         "this loc.", "Δ acc.", "Δ loc."],
+    )  # fmt: skip
+    for arm in ARMS:
+        for variant in sorted({v for a, v in table if a == arm}):
+            r, b = table[(arm, variant)], base.get((arm, variant), {})
+            for stage, key in (("own", "own"), ("unseen, commissioned", "after")):
+                ours = [r[f"{key}_acc"], r[f"{key}_loc"]]
+                if not ours[0]:
+                    continue
+                theirs = [b.get(f"{key}_acc", []), b.get(f"{key}_loc", [])]
+                gaps = [
+                    f"{np.mean(o) - np.mean(t):+.3f}" if t else "–"
+                    for o, t in zip(ours, theirs, strict=True)
+                ]
+                lines.append(
+                    f"| {arm} | {variant} | {stage} | {_cell(theirs[0])} ({len(theirs[0])}) | "
+                    f"{_cell(theirs[1])} | {_cell(ours[0])} ({len(ours[0])}) | "
+                    f"{_cell(ours[1])} | {gaps[0]} | {gaps[1]} |"
+                )
+    return "\n".join(lines) + "\n"
+
+
 def write_csv(table: dict, path: Path) -> None:
     buffer = io.StringIO()
     w = csv.writer(buffer)
@@ -193,6 +223,9 @@ def main() -> None:
     parser.add_argument(
         "--healthy-rate", type=float, help="the models commissioned at this healthy rate"
     )
+    parser.add_argument(
+        "--against", type=Path, help="another campaign root to set each model beside"
+    )
     args = parser.parse_args()
     seeds = set(args.seeds.split(",")) if args.seeds else None
     rate = args.healthy_rate
@@ -209,6 +242,9 @@ def main() -> None:
     if any(v == "gbdt" for _, v in table):
         print(verdict(table, args.sensing))
     print(validation(table, args.sensing))
+    if args.against is not None:
+        base = collect(args.sensing, args.against, seeds, commissioned)
+        print(against(table, base, args.sensing, args.against.name))
 
 
 if __name__ == "__main__":

@@ -101,3 +101,40 @@ $C --out outputs/campaign_arms_grouped --stages own --variants gbdt --seeds 43,4
   --override model.severity=false --steps train
 $PY experiments/arms/summarise.py --sensing stock --out outputs/campaign_arms_grouped \
   > results/arms/table_stock.md
+# 8. (2026-11-27) more data per arm, the candidate named for the full profile's localisation:
+#    twice the training sessions per arm (corpus.train.sessions=16: sessions 8-15 beside the
+#    same eight), the leave-one-arm-out networks (stgnn_fixed and the headline, seeds 42-44) and
+#    stgnn_fixed's own models (seed 42) at 30 epochs on a lent GPU, with the job list below:
+#      CAMPAIGN=outputs/campaign_arms_x2 CORPUS=outputs/corpus/arms_x2 \
+#        CORPUS_OVERRIDES=corpus.train.sessions=16 PAR=16 BUDGET_S=540 \
+#        experiments/arms/gpu_networks.sh outputs/jobs_x2.txt
+#    (one H200, 16 cores, CUDA MPS; run there in two calls on one machine: 68 sessions recorded
+#    and parsed in 154 s, 16 trainings in 175 s, the other 12 in 192 s), unpacked here under
+#    outputs/campaign_arms_x2; here the same corpora (the first eight sessions and the held-out
+#    and healthy ones linked from step 1's), gbdt seeds 42-44, and the rest:
+{ for s in 42 43 44; do for a in ur3e ur5e ur10e ur16e; do
+    echo "full loao $a stgnn_fixed $s"; echo "full loao $a anomaly_residual $s"; done; done
+  for a in ur3e ur5e ur10e ur16e; do echo "full own $a stgnn_fixed 42"; done; } \
+  > outputs/jobs_x2.txt
+for arm in ur5e ur10e ur3e ur16e; do
+  mkdir -p outputs/corpus/arms_x2/$arm
+  for d in outputs/corpus/arms/$arm/*/; do
+    ln -sfn "../../arms/$arm/$(basename "$d")" "outputs/corpus/arms_x2/$arm/$(basename "$d")"
+  done
+  $PY -m robohealth_mj.corpus corpus=arms out_dir=outputs/corpus/arms_x2/$arm \
+    "record_overrides=[\"arm=$arm\"]" progress=false corpus.train.sessions=16
+done
+X="$C --out outputs/campaign_arms_x2 --corpus outputs/corpus/arms_x2"
+$X --stages loao --variants gbdt --seeds 42,43,44 --override model.severity=false \
+  --steps train,commission
+$X --stages loao --variants stgnn_fixed,anomaly_residual --steps rescore,commission
+$X --stages loao --variants stgnn_fixed --healthy-rate 0.99 --steps commission,alarms
+$X --stages own --variants stgnn_fixed --steps rescore
+$PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_x2 \
+  --against outputs/campaign_arms_grouped > results/arms/table_full_x2.md
+$PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_x2 \
+  --healthy-rate 0.99 > results/arms/table_full_x2_hr0.99.md
+# which faulted windows the graph and the trees both mislocalise, at each corpus size
+{ $PY experiments/arms/localisation_errors.py; echo
+  $PY experiments/arms/localisation_errors.py --out outputs/campaign_arms_x2 \
+    --corpus outputs/corpus/arms_x2; } > results/arms/localisation_errors.md
