@@ -79,19 +79,20 @@ def runs(sweep: Path, variants: list[str]) -> list[Path]:
     return sorted(run for run in found if run.parts[-3] in variants)
 
 
-def rescore(run_dir: Path, arm: Path) -> None:
-    """Score ``run_dir`` again on this machine's recording of ``arm``'s held-out session when it
-    was scored on another (a run trained on a lent GPU, whose corpus was recorded there from the
-    same seeds: another numpy can move the physics in its last bits), so that every column of the
-    table reads one recording; the trainer's own score is kept as ``eval_heldout_trained``."""
+def rescore(run_dir: Path, arm_dir: Path) -> None:
+    """Score ``run_dir`` again on this machine's recording of the held-out session in ``arm_dir``
+    (one arm's corpus) when it was scored on another (a run trained on a lent GPU, whose corpus
+    was recorded there from the same seeds: another numpy can move the physics in its last bits),
+    so that every column of the table reads one recording; the trainer's own score is kept as
+    ``eval_heldout_trained``."""
     scored = json.loads((run_dir / "eval_heldout.json").read_text())["data_fingerprint"]
-    if scored == heldout_fingerprint(arm / "heldout_seed900"):
+    if scored == heldout_fingerprint(arm_dir / "heldout_seed900"):
         return
     for ext in ("json", "csv"):
         kept = run_dir / f"eval_heldout_trained.{ext}"
         if not kept.is_file():
             shutil.copy2(run_dir / f"eval_heldout.{ext}", kept)
-    score(run_dir, arm)
+    score(run_dir, arm_dir)
 
 
 @cache
@@ -107,26 +108,26 @@ def commissioned_dir(run_dir: Path, healthy_rate: float | None = None) -> Path:
     )
 
 
-def commission_and_score(run_dir: Path, arm: Path, healthy_rate: float | None = None) -> None:
-    """Commission ``run_dir``'s model on ``arm``'s healthy ten minutes and score it on ``arm``'s
-    held-out session."""
+def commission_and_score(run_dir: Path, arm_dir: Path, healthy_rate: float | None = None) -> None:
+    """Commission ``run_dir``'s model on the healthy ten minutes of ``arm_dir`` (one arm's corpus)
+    and score it on its held-out session."""
     done = commissioned_dir(run_dir, healthy_rate)
     rate = [] if healthy_rate is None else [f"healthy_rate={healthy_rate:g}"]
     if not (done / "best.ckpt").is_file():
         run("robohealth_mj.commission", f"model={run_dir / 'best.ckpt'}",
-            f"healthy={arm / 'healthy_commissioning_seed940'}", f"out={done}",
+            f"healthy={arm_dir / 'healthy_commissioning_seed940'}", f"out={done}",
             *rate)  # fmt: skip
     if not (done / "eval_heldout.json").is_file():
-        score(done, arm)
+        score(done, arm_dir)
 
 
-def score(run_dir: Path, arm: Path) -> None:
-    """``run_dir``'s checkpoint on ``arm``'s held-out session, as ``eval_heldout.json``."""
+def score(run_dir: Path, arm_dir: Path) -> None:
+    """``run_dir``'s checkpoint on the held-out session of ``arm_dir``, as ``eval_heldout.json``."""
     run("robohealth_mj.evaluate", f"ckpt={run_dir / 'best.ckpt'}",
-        f"data={arm / 'heldout_seed900'}", f"out={run_dir / 'eval_heldout'}")  # fmt: skip
+        f"data={arm_dir / 'heldout_seed900'}", f"out={run_dir / 'eval_heldout'}")  # fmt: skip
 
 
-def healthy_alarms(done: Path, arm: Path) -> None:
+def healthy_alarms(done: Path, arm_dir: Path) -> None:
     """The commissioned network's alarms over ``arm``'s healthy hour under the monitor's default
     alarm and evidence policies (``conf/monitor.yaml``): the fleet runtime's decisions over the
     three sessions at once, then the monitor's alarm bank and on-line evaluator
@@ -137,8 +138,8 @@ def healthy_alarms(done: Path, arm: Path) -> None:
         return
     cfg = load_config([])
     policy, evidence = AlarmPolicy(**cfg.alarm), EvidencePolicy(**cfg.evidence)
-    files = [arm / session / "graphs.jsonl" for session in todo]
-    print(f"+ alarms of {done} over {arm.name}'s {', '.join(todo)}", flush=True)
+    files = [arm_dir / session / "graphs.jsonl" for session in todo]
+    print(f"+ alarms of {done} over {arm_dir.name}'s {', '.join(todo)}", flush=True)
     for session, file, decisions in zip(
         todo, files, replay_many(done / "model.onnx", files), strict=True
     ):
