@@ -2,8 +2,8 @@
 
 ``data`` is a file, a session directory or a glob (quote it); ``out`` is the output prefix
 (default: ``eval_<data name>`` next to the checkpoint); ``labels`` how a window is labelled
-(``last``, ``majority``, ``time_weighted``; default: as the model was trained). Writes JSON and CSV
-atomically.
+(``last``, ``majority``, ``time_weighted``, ``visible``; default: as the model was trained).
+Writes JSON and CSV atomically.
 """
 
 from __future__ import annotations

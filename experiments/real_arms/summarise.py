@@ -1,6 +1,8 @@
 """The sim-to-real tables from ``experiments/real_arms/campaign.py``'s verdicts.
 
-    python experiments/real_arms/summarise.py > results/real_arms/sim_to_real.md
+    python experiments/real_arms/summarise.py [--runs GLOB,...] > results/real_arms/sim_to_real.md
+
+``--runs``: only the runs (``outputs/real_arms/<run>/``) whose names match one of these globs.
 
 Networks were replayed through the monitor (alarms, share of ticks called faulty); gbdt, which
 has no streaming form, by its window decisions (share of windows called faulty).
@@ -8,7 +10,9 @@ has no streaming form, by its window decisions (share of windows called faulty).
 
 from __future__ import annotations
 
+import argparse
 import json
+from fnmatch import fnmatch
 from pathlib import Path
 
 from robohealth_mj.logs.convert import convert_log
@@ -60,7 +64,7 @@ def ablation(runs: list[tuple[str, Path]]) -> None:
         models = ROOT / verdicts.parent.name / "models"
         for v in sorted(p.name for p in verdicts.iterdir() if p.is_dir()):
             rows = _rows(verdicts, v, "healthy")
-            (summary,) = models.rglob(f"{v}/w32/seed42/train_summary.json")
+            (summary,) = models.rglob(f"{v}/w32/seed*/train_summary.json")
             d = json.loads(summary.read_text())
             best = next(h for h in d["history"] if h["epoch"] == d["best_epoch"])
             program = _rows(verdicts, v, "program")
@@ -88,10 +92,14 @@ def _line(run: str, v: str, what: str, rows: list[dict]) -> str:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", default="*", help="comma-separated globs of run names")
+    globs = parser.parse_args().runs.split(",")
     # campaign.py --name, and _program / _rate<R> where commissioned otherwise (--commission,
     # --healthy-rate)
     runs = [(p.parent.name + p.name.removeprefix("verdicts"), p)
-            for p in sorted(ROOT.glob("*/verdicts*"))]  # fmt: skip
+            for p in sorted(ROOT.glob("*/verdicts*"))
+            if any(fnmatch(p.parent.name, g) for g in globs)]  # fmt: skip
     ablation(runs)
     print("## Healthy real running (after commissioning on the joint-wise logs, 6.8 min)\n")
     print("`program (selection)`: the twelve program logs (5.6 min), which no run is judged on "
@@ -128,7 +136,7 @@ def main() -> None:
                           f"{r['faulty']:.3f} |")  # fmt: skip
     print(
         "\nPer log: `outputs/real_arms/<run>/verdicts/<model>/<kind>/<log>.json`; "
-        "command: `bash results/real_arms/command.sh`."
+        "command: `bash results/real_arms/command.sh` (the step that writes this file)."
     )
 
 

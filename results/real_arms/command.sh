@@ -31,3 +31,28 @@ $PY experiments/real_arms/campaign.py --curriculum standard --swap stgnn_fixed >
 $PY experiments/real_arms/campaign.py --curriculum replay --swap stgnn_fixed >> results/real_arms/swap_channels.md
 { $PY experiments/real_arms/events.py --run standard; echo;
   $PY experiments/real_arms/events.py --run standard --suffix _rate0.99; } > results/real_arms/events.md
+# Rests (2026-11-27): the residual the arm keeps at rest, real against the twin (rest_offsets.md);
+# then holds in the curriculum, windows labelled by what they show (labels=visible) and the
+# twin's dry friction made to stick (--stiction), each beside the standard recipe, and the
+# standard recipes at three seeds (rests.md; about 100 minutes on 2 cores)
+$PY experiments/real_arms/rest_offsets.py > results/real_arms/rest_offsets.md
+$CAMPAIGN --curriculum programs
+for curriculum in holds standard; do
+  for labels in last visible; do
+    name=$curriculum$([ $labels = visible ] && echo _visible || true)
+    $CAMPAIGN --curriculum $curriculum --labels $labels --name "$name"
+    $CAMPAIGN --curriculum $curriculum --labels $labels --name "$name" --healthy-rate 0.99
+  done
+done
+$CAMPAIGN --curriculum holds --labels visible --name holds_visible_stiction --stiction
+$CAMPAIGN --curriculum standard --name standard_stiction --stiction
+$CAMPAIGN --curriculum standard --name standard_stiction --stiction --healthy-rate 0.99
+for seed in 43 44; do
+  for stiction in "" _stiction; do
+    run="$PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --epochs 10"
+    run+=" --curriculum standard --name standard${stiction}_s$seed ${stiction:+--stiction}"
+    $run
+    $run --healthy-rate 0.99
+  done
+done
+$PY experiments/real_arms/summarise.py --runs 'standard*,holds*,programs' > results/real_arms/rests.md

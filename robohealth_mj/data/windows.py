@@ -1,8 +1,8 @@
 """Windows, the run-aware split and normalisation statistics (thesis §2.4.5-2.4.6).
 
 A window is W consecutive snapshots of one run (never across runs or gaps in sample_index),
-taken every ``stride`` snapshots and labelled by its *final* snapshot, or (``labels=majority`` or
-``time_weighted``, :func:`label_windows`) by what its W snapshots show.
+taken every ``stride`` snapshots and labelled by its *final* snapshot, or (``labels=majority``,
+``time_weighted`` or ``visible``, :func:`label_windows`) by what its W snapshots show.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import numpy as np
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import Recording
-from robohealth_mj.schema import N_JOINTS, feature_index
+from robohealth_mj.schema import FAULT_CLASSES, N_JOINTS, feature_index
 
 
 @dataclass
@@ -150,7 +150,46 @@ def normalisation(x: np.ndarray, windows: Windows) -> tuple[np.ndarray, np.ndarr
     return mean.astype(np.float32), std.astype(np.float32)
 
 
-LABEL_RULES = ("last", "majority", "time_weighted")
+LABEL_RULES = ("last", "majority", "time_weighted", "visible")
+# Faults that act only on a turning joint: on a joint that stands still through a whole window they
+# change nothing any channel reads (friction holds a still joint as firmly as before; a backlash
+# gap under a steady load stays closed on one side).
+MOTION_ONLY_FAULTS = ("backlash", "friction")
+
+
+def _rolling_max_abs(values: np.ndarray, window: int) -> np.ndarray:
+    """``[T, ...]``: the largest ``|values|`` over the ``window`` rows ending at each row (fewer at
+    the start)."""
+    a = np.abs(values)
+    out = a.copy()
+    span = 1
+    while span < window:  # doubling: out covers `span` rows, then 2 * span, up to `window`
+        step = min(span, window - span)
+        out[step:] = np.maximum(out[step:], out[:-step])
+        span += step
+    return out
+
+
+def _hidden_as_healthy(rec: Recording, window: int) -> Recording:
+    """``rec`` with the motion-only faults of a joint that stood still through the window ending
+    at a snapshot relabelled healthy (the ``visible`` rule of :func:`label_windows`)."""
+    motion_only = np.isin(rec.fault_class, [FAULT_CLASSES.index(c) for c in MOTION_ONLY_FAULTS])
+    # each joint's peak speed over the window ending at each snapshot; only snapshots that end a
+    # whole window (one run, no gap in sample_index) are judged, so no window spans a break
+    speed = _rolling_max_abs(rec.x[:, :N_JOINTS, feature_index("vel")], window)
+    ends = np.zeros(len(rec), bool)
+    breaks = np.flatnonzero((np.diff(rec.run) != 0) | (np.diff(rec.sample_index) != 1)) + 1
+    for a, b in itertools.pairwise([0, *breaks, len(rec)]):
+        ends[a + window - 1 : b] = True
+    joint = np.maximum(rec.fault_joint, 0)
+    hidden = ends & motion_only & (speed[np.arange(len(rec)), joint] <= MOVING_RAD_S)
+    return replace(
+        rec,
+        fault_class=np.where(hidden, 0, rec.fault_class).astype(rec.fault_class.dtype),
+        fault_joint=np.where(hidden, -1, rec.fault_joint).astype(rec.fault_joint.dtype),
+        severity=np.where(hidden, 0.0, rec.severity).astype(rec.severity.dtype),
+        active=np.where(hidden, False, rec.active),
+    )
 
 
 def label_windows(rec: Recording, window: int, rule: str = "last") -> Recording:
@@ -161,7 +200,13 @@ def label_windows(rec: Recording, window: int, rule: str = "last") -> Recording:
     - ``majority``: the fault (class and joint) most of the window's snapshots carry (a tie goes to
       the later label); its severity the mean over the snapshots that carry it;
     - ``time_weighted``: the majority's fault, its severity weighted by the share of the window it
-      covers (a window half inside a 0.6 fault: 0.3).
+      covers (a window half inside a 0.6 fault: 0.3);
+    - ``visible``: the final snapshot's label, except that a fault that acts only on a turning
+      joint (:data:`MOTION_ONLY_FAULTS`) on a joint that never turned faster than
+      :data:`MOVING_RAD_S` in the window is labelled healthy: the window is what a healthy joint
+      shows. Without it a curriculum with dwells teaches that a still arm is as likely faulted as
+      not (half of its still windows carry a fault nothing shows), and the model then calls
+      healthy holds faulty.
 
     A window that lies inside one fault interval keeps its label under every rule; only windows
     that straddle a change differ. Snapshots that end no whole window keep their own label.
@@ -170,6 +215,8 @@ def label_windows(rec: Recording, window: int, rule: str = "last") -> Recording:
         raise InputError(f"labels must be one of {list(LABEL_RULES)}, got {rule!r}")
     if rule == "last" or len(rec) < window:
         return rec
+    if rule == "visible":
+        return _hidden_as_healthy(rec, window)
     code = rec.fault_class * (N_JOINTS + 1) + (rec.fault_joint + 1)  # one id per (class, joint)
     codes = np.unique(code)
 

@@ -46,7 +46,7 @@ def score_checkpoint(
 ) -> Scored:
     """Rebuild the exact model from its checkpoint and predict every window of ``data`` (what
     evaluation and any per-window measurement share). Windows are labelled by ``labels``
-    (``last``, ``majority``, ``time_weighted``; default: the rule the model was trained with)."""
+    (``last``, ``majority``, ``time_weighted``, ``visible``; default: the model's training rule)."""
     ckpt = load_checkpoint(ckpt_path)
     files = expand_paths(data)
     check_recordings(ckpt, files)

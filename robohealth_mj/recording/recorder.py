@@ -44,6 +44,9 @@ from robohealth_mj.sim.twin_file import read_twin_noise
 GRAPHS_FILE = "graphs.jsonl"
 MANIFEST_FILE = "manifest.json"
 _IDENTITY_EXCLUDE = ("out_dir", "progress", "run_id")
+# sim settings added after recordings were made: left out of the id while unset, so that adding
+# them kept every earlier recording's id
+_OPTIONAL_SIM = ("friction_solref", "friction_solimp")
 
 
 def session_config(cfg: DictConfig) -> dict[str, Any]:
@@ -55,6 +58,9 @@ def default_run_id(cfg: DictConfig) -> str:
     """A run id fixed by what was simulated (same config, same id, same bytes)."""
     data = session_config(cfg)
     data["session"] = {k: v for k, v in data["session"].items() if k not in _IDENTITY_EXCLUDE}
+    for key in _OPTIONAL_SIM:
+        if data.get("sim", {}).get(key, 0) is None:
+            del data["sim"][key]
     digest = hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:10]
     return recorded_run_id(arm_name(cfg), cfg.seed, digest)
 

@@ -1,6 +1,8 @@
 """The trajectory curriculum (thesis §2.3.2): sweeps, coordinated pairs and whole-arm motion;
 and, for probing programs unlike those, pick-and-place and palletising cycles as taught on a
-pendant (point-to-point moves with dwells, family ``pick_place``; not in the default families).
+pendant (point-to-point moves with dwells, family ``pick_place``); and holds (family ``hold``: one
+move from rest to a new pose, then the arm holds it, as a real arm spends much of its day). The
+last two are not in the default families.
 
 Speed scales multiply the base excitation frequency; payload scales multiply a nominal payload.
 Segments are shuffled per pass by the session seed. Each segment starts at the previous segment's
@@ -20,7 +22,7 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import N_JOINTS
 from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 
-FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place")
+FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place", "hold")
 WAVEFORMS = ("sine", "triangle", "compound")
 TASKS = ("pick_place", "palletise")  # the pick_place family's programs
 LEG_S = 0.8  # the shortest point-to-point move at speed scale 1, s
@@ -163,6 +165,8 @@ class Curriculum:
             out.append(
                 Segment(len(out), "pick_place", task, tuple(range(N_JOINTS)), speed, payload)
             )
+        for speed, payload in itertools.product(speeds, payloads):
+            out.append(Segment(len(out), "hold", "rest", tuple(range(N_JOINTS)), speed, payload))
         return [s for s in out if s.family in self.families]
 
     def __len__(self) -> int:
@@ -253,6 +257,9 @@ class Curriculum:
         tau = np.asarray(t, dtype=float)[:, None] - sched.t_start
         if seg.family == "pick_place":
             return self._point_to_point(visit, tau)
+        if seg.family == "hold":  # one move, blend_s long at speed scale 1, then the pose held
+            move = smoothstep(tau * seg.speed_scale / self.blend_s)
+            return sched.start_pose + (sched.center - sched.start_pose) * move
         blend = smoothstep(tau / self.blend_s)
         envelope = blend * smoothstep((self.segment_s - tau) / self.blend_s)
         omega = 2.0 * np.pi * self.base_frequency_hz * seg.speed_scale

@@ -6,7 +6,7 @@ turns it into MJCF with our drive model through dm-control's ``mjcf``, and ``muj
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -44,6 +44,8 @@ def build_model(
     scene: Path | str = SCENE_XML,
     twin: Path | str | None = None,
     mount_height_m: float = 0.0,
+    friction_solref: Sequence[float] | None = None,
+    friction_solimp: Sequence[float] | None = None,
 ) -> mujoco.MjModel:
     """Compile arm ``arm`` in the scene at physics time step ``timestep``.
 
@@ -54,6 +56,13 @@ def build_model(
     (``python -m robohealth_mj.identify``) whose drive parameters replace the scaled ones (before
     ``drive_overrides``). ``mount_height_m``: the base stands this high above the floor (a
     real arm on a table or pedestal, whose program reaches below its base plane).
+    ``friction_solref`` ``[timeconst, dampratio]`` and ``friction_solimp`` ``[dmin, dmax, width,
+    midpoint, power]``: the motor joints' dry friction constraint (MuJoCo's ``solreffriction`` and
+    ``solimpfriction``; default MuJoCo's own). MuJoCo's dry friction is soft: a joint held below
+    its friction limit creeps, so a servo at rest pulls it onto its target within a fraction of a
+    second and the drive ends up carrying exactly the model torque. A shorter time constant and an
+    impedance nearer 1 make it stick, as a real gear does: the drive then keeps whatever torque
+    it stopped with.
     """
     scene = Path(scene)
     if not scene.is_file():
@@ -85,7 +94,23 @@ def build_model(
         per_joint[joint].update({k: float(v) for k, v in params.items()})
     root = build_arm_scene(description, per_joint, scene, float(mount_height_m))
     root.option.timestep = float(timestep)
-    return mujoco.MjModel.from_xml_string(root.to_xml_string(), assets=root.get_assets())
+    compiled = mujoco.MjModel.from_xml_string(root.to_xml_string(), assets=root.get_assets())
+    if friction_solref is not None:
+        solref = [float(v) for v in friction_solref]
+        if len(solref) != 2 or not solref[0] >= 2 * float(timestep) or not solref[1] > 0:
+            raise InputError(
+                f"sim.friction_solref: [timeconst >= 2 x timestep, dampratio > 0], got {solref}"
+            )
+        compiled.dof_solref[ArmIndex.of(compiled).motor_dof] = solref
+    if friction_solimp is not None:
+        solimp = [float(v) for v in friction_solimp]
+        if len(solimp) != 5 or not 0 < solimp[0] <= solimp[1] < 1:
+            raise InputError(
+                f"sim.friction_solimp: [dmin, dmax, width, midpoint, power] with "
+                f"0 < dmin <= dmax < 1, got {solimp}"
+            )
+        compiled.dof_solimp[ArmIndex.of(compiled).motor_dof] = solimp
+    return compiled
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ from functools import cache
 
 import numpy as np
 import pytest
-from omegaconf import DictConfig
+from omegaconf import DictConfig, open_dict
 
 from robohealth_mj.common.config import compose_config
 from robohealth_mj.data.arrays import Recording
@@ -102,3 +102,13 @@ def test_one_arm_splits_as_by_run(seed):
     which = _by_run(rec, windows, seed)
     for i, name in enumerate(("train", "val", "test")):
         np.testing.assert_array_equal(splits[name].start, windows.start[which == i])
+
+
+def test_friction_settings_left_unset_keep_the_run_id_of_a_config_without_them():
+    cfg = _record_config("ur5e").copy()
+    older = cfg.copy()  # a config from before the settings existed
+    with open_dict(older.sim):
+        del older.sim["friction_solref"], older.sim["friction_solimp"]
+    assert default_run_id(cfg) == default_run_id(older)
+    cfg.sim.friction_solref = [0.002, 1.0]  # set, it is part of what was simulated
+    assert default_run_id(cfg) != default_run_id(older)

@@ -1,6 +1,9 @@
-"""Windows labelled by what they show: only the windows that straddle a change differ."""
+"""Windows labelled by what they show: only the windows that straddle a change differ, or (rule
+``visible``) those whose fault nothing shows."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -8,6 +11,7 @@ import pytest
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import Recording
 from robohealth_mj.data.windows import label_windows, make_windows
+from robohealth_mj.schema import feature_index
 
 W = 8
 
@@ -64,3 +68,27 @@ def test_last_is_the_recording_itself_and_an_unknown_rule_is_refused():
     assert label_windows(rec, W, "last") is rec
     with pytest.raises(InputError, match="labels must be one of"):
         label_windows(rec, W, "first")
+
+
+def test_visible_calls_healthy_exactly_the_motion_only_faults_of_a_joint_that_stood_still():
+    rec = _recording()
+    vel = rec.x[:, :6, feature_index("vel")]  # a view: what the rule reads
+    vel[12, 2] = 0.2  # the friction's elbow turns once, at snapshot 12
+    vel[:, 4] = 0.5  # another joint turns all along: it shows nothing of the elbow
+    vel[33:40, 3] = 0.0  # the jammed wrist_1 stands still
+    cls, joint = rec.fault_class.copy(), rec.fault_joint.copy()
+    cls[50:58], joint[50:58] = 1, 0  # backlash on the base at the head of run 1 ...
+    vel[48, 0] = 0.3  # ... whose base stands still; only run 0 turned it, at its end
+    rec = replace(rec, fault_class=cls, fault_joint=joint, active=cls > 0)
+    out = label_windows(rec, W, "visible")
+    changed = np.flatnonzero(out.fault_class != rec.fault_class)
+    # friction windows ending 10, 11 and 20-24 do not hold snapshot 12; the base never turned in
+    # run 1 (its first W - 1 snapshots end no whole window: they keep their label)
+    assert changed.tolist() == [10, 11, *range(20, 25), *range(57, 58), *range(60, 70)]
+    assert (out.fault_joint[changed] == -1).all() and (out.severity[changed] == 0).all()
+    assert not out.active[changed].any()
+    assert (out.fault_class[12:20] == 2).all()  # the turn is inside these windows: kept
+    assert (out.fault_class[33:40] == 3).all()  # a jam acts on a still joint too: kept
+    vel[65, 0] = -0.06  # a turn either way, just above MOVING_RAD_S, shows the backlash
+    again = label_windows(rec, W, "visible")
+    assert (again.fault_class[65:70] == 1).all() and (again.fault_class[60:65] == 0).all()

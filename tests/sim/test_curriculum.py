@@ -105,3 +105,24 @@ def test_pick_and_place_programs_move_point_to_point_and_dwell(record_cfg, model
             mujoco.mj_collision(model, data)
             assert data.ncon == 0, (visit, pose)
     assert np.abs(np.diff(np.concatenate(q_all), axis=0)).max() < SPEED_LIMIT * 0.002 * 1.01
+
+
+def test_holds_move_once_from_rest_to_a_new_pose_and_hold_it(record_cfg):
+    """Family hold: one move per segment, starting at the previous pose, ending at rest at the
+    segment's centre within blend_s / speed scale, then no motion at all for the rest of the
+    segment; a faster scale moves sooner; the default families leave holds out."""
+    c = _curriculum(record_cfg, "curriculum.families=[hold]", seed=5)
+    assert len(c) == 9 and {s.family for s in c.segments} == {"hold"}
+    for visit in range(len(c)):
+        sched = c.scheduled(visit)
+        t = sched.t_start + np.arange(0.0, c.segment_s, 0.002)
+        q, qd, _ = c.reference(visit, t)
+        np.testing.assert_allclose(q[0], sched.start_pose, atol=1e-9)
+        move_s = c.blend_s / sched.segment.speed_scale
+        moving = np.abs(qd).max(axis=1) > 1e-6
+        assert moving[t - sched.t_start < 0.5 * move_s].any()  # it moves at the start ...
+        assert not moving[t - sched.t_start > move_s + 0.01].any()  # ... and then holds
+        np.testing.assert_allclose(q[-1], sched.center, atol=1e-9)
+        assert np.abs(qd).max() <= SPEED_LIMIT
+    default = _curriculum(record_cfg, seed=5)
+    assert "hold" not in {s.family for s in default.segments}

@@ -8,6 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.dynamics import gravity_torques
 from robohealth_mj.sim.model import HOME_POSE, ArmIndex, build_model
@@ -72,3 +73,35 @@ def test_drive_overrides_edit_the_named_joint_only():
 def test_missing_scene_is_a_clear_error(tmp_path: Path):
     with pytest.raises(FileNotFoundError, match="scene file not found"):
         build_model(scene=tmp_path / "nope.xml")
+
+
+def _creep(model: mujoco.MjModel, seconds: float = 2.0) -> float:
+    """How far the base's motor turns in ``seconds`` pushed at half its dry friction, with the
+    servo off and no gravity: a sticking joint stays put, a creeping one does not."""
+    model.opt.gravity[:] = 0.0
+    model.actuator_gainprm[:] = 0.0
+    model.actuator_biasprm[:] = 0.0
+    data = mujoco.MjData(model)
+    dof = ArmIndex.of(model).motor_dof[0]
+    data.qfrc_applied[dof] = 0.5 * model.dof_frictionloss[dof]
+    for _ in range(round(seconds / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+    return abs(float(data.qpos[model.jnt_qposadr[model.dof_jntid[dof]]]))
+
+
+def test_a_stiff_friction_constraint_makes_a_joint_stick_where_the_default_creeps():
+    soft = _creep(build_model())
+    stiff = build_model(
+        friction_solref=[0.002, 1.0], friction_solimp=[0.999, 0.9999, 0.001, 0.5, 2]
+    )
+    assert soft > 1e-3  # MuJoCo's default dry friction gives way below its limit
+    assert _creep(stiff) < soft / 50
+    index = ArmIndex.of(stiff)
+    np.testing.assert_allclose(stiff.dof_solref[index.motor_dof], [[0.002, 1.0]] * 6)
+    np.testing.assert_allclose(
+        stiff.dof_solref[index.deflection_dof], build_model().dof_solref[index.deflection_dof]
+    )
+    for bad in ({"friction_solref": [0.0005, 1.0]}, {"friction_solref": [0.01]},
+                {"friction_solimp": [0.9, 1.0, 0.001, 0.5, 2]}):  # fmt: skip
+        with pytest.raises(InputError, match=r"sim\.friction_sol"):
+            build_model(**bad)
