@@ -204,9 +204,8 @@ def label_windows(rec: Recording, window: int, rule: str = "last") -> Recording:
     - ``visible``: the final snapshot's label, except that a fault that acts only on a turning
       joint (:data:`MOTION_ONLY_FAULTS`) on a joint that never turned faster than
       :data:`MOVING_RAD_S` in the window is labelled healthy: the window is what a healthy joint
-      shows. Without it a curriculum with dwells teaches that a still arm is as likely faulted as
-      not (half of its still windows carry a fault nothing shows), and the model then calls
-      healthy holds faulty.
+      shows (36-43 % of those classes' windows in the quick corpus, where single-joint sweeps
+      leave the other joints still).
 
     A window that lies inside one fault interval keeps its label under every rule; only windows
     that straddle a change differ. Snapshots that end no whole window keep their own label.
