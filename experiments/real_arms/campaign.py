@@ -146,9 +146,9 @@ CORPORA = {
 
 
 # The twin's dry friction made to stick (``sim.friction_solref``): MuJoCo's default friction creeps,
-# so a simulated hold ends with the residual near zero (median 0.2-0.4 on the big joints, in the
-# models' units), where this arm's holds keep 0.3-1.2 (up to 4.2) after a move; with this setting
-# the simulated holds keep 2.2-3.6 (p90 2.7-4.0).
+# so a simulated rest keeps a residual offset of 0.25-0.89 N m on the big joints (median), where
+# this arm's rests keep 0.94-2.01 (p90 4.1-7.4); with this setting the twin's keep 2.2-7.9
+# (results/real_arms/rest_offsets.md, whose script holds the same override).
 STICTION = ["sim.friction_solref=[0.002,1]"]
 
 

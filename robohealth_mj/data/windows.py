@@ -157,32 +157,17 @@ LABEL_RULES = ("last", "majority", "time_weighted", "visible")
 MOTION_ONLY_FAULTS = ("backlash", "friction")
 
 
-def _rolling_max_abs(values: np.ndarray, window: int) -> np.ndarray:
-    """``[T, ...]``: the largest ``|values|`` over the ``window`` rows ending at each row (fewer at
-    the start)."""
-    a = np.abs(values)
-    out = a.copy()
-    span = 1
-    while span < window:  # doubling: out covers `span` rows, then 2 * span, up to `window`
-        step = min(span, window - span)
-        out[step:] = np.maximum(out[step:], out[:-step])
-        span += step
-    return out
-
-
 def _hidden_as_healthy(rec: Recording, window: int) -> Recording:
     """``rec`` with the motion-only faults of a joint that stood still through the window ending
-    at a snapshot relabelled healthy (the ``visible`` rule of :func:`label_windows`)."""
-    motion_only = np.isin(rec.fault_class, [FAULT_CLASSES.index(c) for c in MOTION_ONLY_FAULTS])
-    # each joint's peak speed over the window ending at each snapshot; only snapshots that end a
-    # whole window (one run, no gap in sample_index) are judged, so no window spans a break
-    speed = _rolling_max_abs(rec.x[:, :N_JOINTS, feature_index("vel")], window)
-    ends = np.zeros(len(rec), bool)
-    breaks = np.flatnonzero((np.diff(rec.run) != 0) | (np.diff(rec.sample_index) != 1)) + 1
-    for a, b in itertools.pairwise([0, *breaks, len(rec)]):
-        ends[a + window - 1 : b] = True
-    joint = np.maximum(rec.fault_joint, 0)
-    hidden = ends & motion_only & (speed[np.arange(len(rec)), joint] <= MOVING_RAD_S)
+    at a snapshot relabelled healthy (the ``visible`` rule of :func:`label_windows`): every
+    snapshot that ends a whole window, judged as the evaluation's strata are
+    (:func:`target_joint_moved`)."""
+    ending = make_windows(rec, window, stride=1)
+    motion_only = np.isin(
+        rec.fault_class[ending.end], [FAULT_CLASSES.index(c) for c in MOTION_ONLY_FAULTS]
+    )
+    hidden = np.zeros(len(rec), bool)
+    hidden[ending.end] = motion_only & ~target_joint_moved(rec, ending)
     return replace(
         rec,
         fault_class=np.where(hidden, 0, rec.fault_class).astype(rec.fault_class.dtype),
