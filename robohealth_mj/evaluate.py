@@ -2,7 +2,9 @@
 
 ``data`` is a file, a session directory or a glob (quote it); ``out`` is the output prefix
 (default: ``eval_<data name>`` next to the checkpoint); ``labels`` how a window is labelled
-(``last``, ``majority``, ``time_weighted``, ``visible``; default: as the model was trained).
+(``last``, ``majority``, ``time_weighted``, ``visible``; default: as the model was trained);
+``observability`` which calls the model may make (``all``; ``motion``: friction and backlash only
+on a joint that moved in the window, :mod:`robohealth_mj.data.observability`).
 Writes JSON and CSV atomically.
 """
 
@@ -23,7 +25,7 @@ def main(cfg: DictConfig) -> None:
     if not cfg.ckpt or not cfg.data:
         raise SystemExit("usage: python -m robohealth_mj.evaluate ckpt=PATH data=PATH [out=PREFIX]")
     with one_line_errors("evaluate"):
-        result = evaluate_checkpoint(cfg.ckpt, cfg.data, cfg.device, cfg.labels)
+        result = evaluate_checkpoint(cfg.ckpt, cfg.data, cfg.device, cfg.labels, cfg.observability)
     prefix = cfg.out or Path(cfg.ckpt).parent / f"eval_{Path(str(cfg.data)).stem}"
     json_path, _ = write_evaluation(result, prefix)
     m = result["metrics"]

@@ -56,7 +56,7 @@ def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> 
         read_metadata(cfg.model)  # a model named but unusable is the user's to fix
     runtime = ModelRuntime(
         cfg.model, threads=cfg.threads, alarm=policy, incremental=cfg.incremental,
-        evidence=evidence,
+        evidence=evidence, observability=cfg.observability,
     )  # fmt: skip
     if cfg.source != "ros2":
         return monitor_stream(cfg, runtime, policy, evidence)

@@ -6,6 +6,7 @@ real logs and monitor the arm's other real logs.
     python experiments/real_arms/campaign.py [--curriculum standard|replay|mixed|programs|holds]
         [--commission jointwise|jointwise+program] [--healthy-rate R] [--twin FILE] [--name RUN]
         [--variants gbdt,stgnn_fixed] [--seed 42] [--epochs 10] [--labels last|visible]
+        [--observability all|motion]
 
 ``--curriculum standard`` trains on our sweeps and payloads (the quick corpus on the twin);
 ``replay`` on the arm's own program: the ``program`` logs replayed on the twin with no payload
@@ -15,7 +16,10 @@ the standard sweeps and pendant-taught point-to-point programs (``pick_place`` f
 ``--commission`` names the healthy real running the models are commissioned on; ``--labels`` how
 training windows are labelled (``train labels=``; ``visible``: friction and backlash on a joint
 that stood still through the window, which nothing shows, as healthy); ``--stiction`` records the
-corpora with the twin's dry friction made to stick (``STICTION``). Writes under
+corpora with the twin's dry friction made to stick (``STICTION``); ``--observability motion``
+monitors (and, for gbdt, evaluates) with friction and backlash called only on joints that moved
+in the window (``monitor observability=motion``; verdicts in ``verdicts<suffix>_motion``, the
+same commissioned models). Writes under
 ``outputs/real_arms/``: ``twin/`` (twin.yaml, fidelity.md), the corpora
 ``outputs/corpus/real_ur10e_<curriculum>``, and per run (``--name``, default the curriculum) the
 models ``<run>/models/`` and per model and log the monitor's verdict (``<run>/verdicts/``). Every
@@ -245,6 +249,12 @@ def main() -> None:
         action="store_true",
         help="record the corpora on the twin with sticking dry friction (STICTION)",
     )
+    parser.add_argument(
+        "--observability",
+        choices=("all", "motion"),
+        default="all",
+        help="monitor observability= (motion: friction and backlash only on joints that moved)",
+    )
     parser.add_argument("--curriculum", choices=tuple(CURRICULA), default="replay")
     parser.add_argument("--commission", choices=tuple(COMMISSION), default="jointwise")
     parser.add_argument(
@@ -298,7 +308,8 @@ def main() -> None:
             "trainer.progress=false",
             "hydra/launcher=local", f"hydra.sweep.dir={sweep}")  # fmt: skip
     commissioning = [p for role in COMMISSION[args.commission] for p in LOGS_ROLES[role]]
-    verdicts = ROOT / name / f"verdicts{suffix}"
+    gate = "_motion" if args.observability == "motion" else ""
+    verdicts = ROOT / name / f"verdicts{suffix}{gate}"
     for ckpt in sorted(p for p in sweep.rglob("best.ckpt") if "commissioned" not in p.parent.name):
         variant = next(part for part in ckpt.parts if part in args.variants.split(","))
         done = ckpt.parent / f"commissioned{suffix}"
@@ -318,10 +329,12 @@ def main() -> None:
             out.parent.mkdir(parents=True, exist_ok=True)
             if (done / "model.onnx").is_file():
                 run("robohealth_mj.monitor", "source=replay", f"model={done / 'model.onnx'}",
-                    f"file={log}", "evaluate=true", "quiet=true", f"out={out}")  # fmt: skip
+                    f"file={log}", "evaluate=true", "quiet=true", f"out={out}",
+                    f"observability={args.observability}")  # fmt: skip
             else:  # a tree ensemble has no streaming form: its window decisions on the log
                 run("robohealth_mj.evaluate", f"ckpt={done / 'best.ckpt'}", f"data={log}",
-                    f"out={out.with_suffix('')}")  # fmt: skip
+                    f"out={out.with_suffix('')}",
+                    f"observability={args.observability}")  # fmt: skip
     print(json.dumps({"verdicts": str(verdicts)}))
 
 

@@ -5,7 +5,8 @@ joint's residual leaves its level of 1-3 s before by more than ``--share`` of it
 The joint nearest the push is the most distal joint the push loads that much (a force on a link
 loads no joint beyond it).
 
-    python experiments/real_arms/events.py [--run replay] > results/real_arms/events.md
+    python experiments/real_arms/events.py [--run replay] [--suffix _rate0.99]
+        [--observability all|motion] > results/real_arms/events.md
 
 Per commissioned network (``outputs/real_arms/<run>/models/**/commissioned/model.onnx``), per
 push: when and how long, the share of its ticks called faulty, whether an alarm rose during it
@@ -52,19 +53,23 @@ def main() -> None:
     parser.add_argument("--run", default="replay", help="a campaign run under outputs/real_arms/")
     parser.add_argument("--share", type=float, default=0.05, help="of the joint's rated torque")
     parser.add_argument("--suffix", default="", help="commissioned<SUFFIX>/ (campaign.py's)")
+    parser.add_argument(
+        "--observability", default="all", help="monitor observability= (all, motion)"
+    )
     args = parser.parse_args()
     models = sorted(Path(f"outputs/real_arms/{args.run}/models").rglob(
         f"commissioned{args.suffix}/model.onnx"))  # fmt: skip
-    print(f"## Pushed while holding a pose (run {args.run}{args.suffix})\n")
+    print(f"## Pushed while holding a pose (run {args.run}{args.suffix}, "
+          f"observability={args.observability})\n")  # fmt: skip
     print(f"A push: a joint's residual more than {args.share:.0%} of its rated torque off its "
           "level 1-3 s before.\n")  # fmt: skip
-    print("| model | log | push at s | lasts s | called faulty | alarm | joint named | nearest "
-          "joint |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|---|")
+    print("| model | log | push at s | lasts s | called faulty | class called | alarm "
+          "| joint named | nearest joint |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|---|")
     for model in models:
         variant = model.parts[-5]  # <variant>/w32/seed42/commissioned/model.onnx
         for log in sorted(LOGS.glob("*.csv")):
-            runtime = ModelRuntime(str(model))
+            runtime = ModelRuntime(str(model), observability=args.observability)
             samples = [s for _, s, _ in replay_stream(str(log))]
             said = [runtime.process("arm", s) for s in samples]
             off, found = pushes(np.stack([s.x[: schema.N_JOINTS, RESIDUAL] for s in samples]),
@@ -75,10 +80,12 @@ def main() -> None:
                 after = said[first : last + 1 + 32]  # an alarm within one window of the push
                 alarm = any(d.alarm == "raised" for d in after)
                 named = Counter(d.localised_joint for d in faulty).most_common(1)
+                called = Counter(d.fault_class for d in faulty).most_common(1)
                 loaded = np.flatnonzero(off[first : last + 1].max(axis=0) > args.share)
                 print(f"| {variant} | {log.stem} | {first / TICK_HZ:.1f} | "
                       f"{(last - first + 1) / TICK_HZ:.1f} | {len(faulty) / len(during):.2f} | "
-                      f"{'yes' if alarm else 'no'} | {named[0][0] if named else '-'} | "
+                      f"{called[0][0] if called else '-'} | {'yes' if alarm else 'no'} | "
+                      f"{named[0][0] if named else '-'} | "
                       f"{schema.JOINT_NAMES[loaded.max()]} |")  # fmt: skip
 
 

@@ -96,7 +96,7 @@ def main() -> None:
     parser.add_argument("--runs", default="*", help="comma-separated globs of run names")
     globs = parser.parse_args().runs.split(",")
     # campaign.py --name, and _program / _rate<R> where commissioned otherwise (--commission,
-    # --healthy-rate)
+    # --healthy-rate), _motion where monitored with --observability motion
     runs = [(p.parent.name + p.name.removeprefix("verdicts"), p)
             for p in sorted(ROOT.glob("*/verdicts*"))
             if any(fnmatch(p.parent.name, g) for g in globs)]  # fmt: skip
@@ -106,7 +106,8 @@ def main() -> None:
           "(in-sample for the runs that replay them: replay, mixed). The rest: the monitored "
           "healthy logs without payload that neither commission nor are replayed "
           "(`healthy_monitored` in campaign.py). Run suffixes: `_program` commissioned on the "
-          "program logs as well, `_rate<R>` at healthy rate R.\n")  # fmt: skip
+          "program logs as well, `_rate<R>` at healthy rate R, `_motion` monitored with "
+          "`observability=motion`.\n")  # fmt: skip
     print("| run | model | logs | n | healthy minutes | alarms | alarms / h "
           "| share called faulty |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|")

@@ -56,3 +56,22 @@ for seed in 43 44; do
   done
 done
 $PY experiments/real_arms/summarise.py --runs 'standard*,holds*,programs' > results/real_arms/rests.md
+# Observability (2026-11-27, fourteenth session): the same models monitored with friction and
+# backlash called only on joints that moved in the window (monitor/evaluate observability=motion;
+# observability.md), its cost on the twin's held-out session (observability_cost.md) and on the
+# pushes (events_observability.md); about 40 minutes on 2 cores with the standard runs above
+for rate in "" "--healthy-rate 0.99"; do
+  $CAMPAIGN --curriculum standard --observability motion $rate
+  for seed in 43 44; do
+    run="$PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --epochs 10"
+    run+=" --curriculum standard --name standard_s$seed"
+    $run $rate
+    $run --observability motion $rate
+  done
+done
+$PY experiments/real_arms/summarise.py --runs 'standard,standard_rate0.99,standard_s4*' \
+  > results/real_arms/observability.md
+$PY experiments/real_arms/observability_cost.py > results/real_arms/observability_cost.md
+for obs in all motion; do
+  $PY experiments/real_arms/events.py --run standard --suffix _rate0.99 --observability $obs; echo
+done > results/real_arms/events_observability.md

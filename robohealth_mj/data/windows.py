@@ -15,6 +15,7 @@ import numpy as np
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import Recording
+from robohealth_mj.data.observability import MOTION_ONLY_FAULTS, MOVING_RAD_S
 from robohealth_mj.schema import FAULT_CLASSES, N_JOINTS, feature_index
 
 
@@ -46,7 +47,12 @@ def make_windows(rec: Recording, window: int, stride: int | None = None) -> Wind
     return Windows(np.concatenate(starts).astype(np.int64), window)
 
 
-MOVING_RAD_S = 0.05  # a joint turning slower than this (3 deg/s) counts as still
+def joints_moved(rec: Recording, windows: Windows, threshold: float = MOVING_RAD_S) -> np.ndarray:
+    """``[K, J]``: each joint turned faster than ``threshold`` at some tick of each window (what
+    :mod:`robohealth_mj.data.observability` calls *moved*)."""
+    rows = windows.start[:, None] + np.arange(windows.window)[None, :]  # [K, W]
+    speed = np.abs(rec.x[rows, :N_JOINTS, feature_index("vel")])  # [K, W, J]
+    return speed.max(axis=1) > threshold
 
 
 def target_joint_moved(
@@ -59,10 +65,8 @@ def target_joint_moved(
     in such windows; the evaluation reports both strata.
     """
     joint = rec.fault_joint[windows.end]
-    offsets = np.arange(windows.window)
-    rows = windows.start[:, None] + offsets[None, :]  # [K, W]
-    speed = np.abs(rec.x[rows, np.maximum(joint, 0)[:, None], feature_index("vel")])
-    return (joint >= 0) & (speed.max(axis=1) > threshold)
+    moved = joints_moved(rec, windows, threshold)
+    return (joint >= 0) & moved[np.arange(len(joint)), np.maximum(joint, 0)]
 
 
 SPLITS = ("train", "val", "test")
@@ -151,10 +155,6 @@ def normalisation(x: np.ndarray, windows: Windows) -> tuple[np.ndarray, np.ndarr
 
 
 LABEL_RULES = ("last", "majority", "time_weighted", "visible")
-# Faults that act only on a turning joint: on a joint that stands still through a whole window they
-# change nothing any channel reads (friction holds a still joint as firmly as before; a backlash
-# gap under a steady load stays closed on one side).
-MOTION_ONLY_FAULTS = ("backlash", "friction")
 
 
 def _hidden_as_healthy(rec: Recording, window: int) -> Recording:

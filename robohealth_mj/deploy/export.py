@@ -30,6 +30,7 @@ from robohealth_mj.data.windows import make_windows
 from robohealth_mj.learn.checkpoint import (
     check_recordings,
     graph_from_checkpoint,
+    joint_score_kind,
     load_checkpoint,
     model_from_checkpoint,
 )
@@ -294,15 +295,6 @@ def commissioning_metadata(ckpt: dict[str, Any]) -> dict[str, str]:
         "commissioning_data_fingerprint": record["healthy_fingerprint"],
         "commissioning_healthy_minutes": str(record["healthy_minutes"]),
     }
-
-
-def joint_score_kind(ckpt: dict[str, Any]) -> str:
-    """How the runtime turns joint logits into scores, as the model was trained: ``softmax``
-    over the joints (the default loss: one joint at fault, the joints compete) or ``sigmoid``
-    per joint (the thesis's BCE). Softmax-trained logits are not sigmoid-calibrated: on a
-    confident window every joint's logit is large, and sigmoid scores all saturate at 1."""
-    trainer = (ckpt.get("config") or {}).get("trainer") or {}
-    return "softmax" if trainer.get("joint_softmax", True) else "sigmoid"
 
 
 def model_metadata(

@@ -147,6 +147,15 @@ def graph_from_checkpoint(ckpt: dict[str, Any]) -> GraphSpec:
     )
 
 
+def joint_score_kind(ckpt: dict[str, Any]) -> str:
+    """How the runtime turns joint logits into scores, as the model was trained: ``softmax``
+    over the joints (the default loss: one joint at fault, the joints compete) or ``sigmoid``
+    per joint (the thesis's BCE). Softmax-trained logits are not sigmoid-calibrated: on a
+    confident window every joint's logit is large, and sigmoid scores all saturate at 1."""
+    trainer = (ckpt.get("config") or {}).get("trainer") or {}
+    return "softmax" if trainer.get("joint_softmax", True) else "sigmoid"
+
+
 def model_from_checkpoint(ckpt: dict[str, Any]) -> nn.Module:
     graph = graph_from_checkpoint(ckpt)
     model = build_model(

@@ -14,10 +14,19 @@ import torch
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
-from robohealth_mj.data.windows import Windows, label_windows, make_windows, target_joint_moved
+from robohealth_mj.data.observability import check_observability, hide_unobservable
+from robohealth_mj.data.sensing import load_profile
+from robohealth_mj.data.windows import (
+    Windows,
+    joints_moved,
+    label_windows,
+    make_windows,
+    target_joint_moved,
+)
 from robohealth_mj.learn.checkpoint import (
     check_recordings,
     graph_from_checkpoint,
+    joint_score_kind,
     load_checkpoint,
     model_from_checkpoint,
 )
@@ -42,15 +51,22 @@ class Scored:
 
 
 def score_checkpoint(
-    ckpt_path: Path | str, data: list[str] | str, device: str = "auto", labels: str | None = None
+    ckpt_path: Path | str,
+    data: list[str] | str,
+    device: str = "auto",
+    labels: str | None = None,
+    observability: str = "all",
 ) -> Scored:
     """Rebuild the exact model from its checkpoint and predict every window of ``data`` (what
     evaluation and any per-window measurement share). Windows are labelled by ``labels``
-    (``last``, ``majority``, ``time_weighted``, ``visible``; default: the model's training rule)."""
+    (``last``, ``majority``, ``time_weighted``, ``visible``; default: the model's training rule);
+    ``observability=motion`` calls motion-only faults only on joints that moved
+    (:mod:`robohealth_mj.data.observability`), as the monitor does with the same setting."""
     ckpt = load_checkpoint(ckpt_path)
+    graph = graph_from_checkpoint(ckpt)
+    check_observability(observability, load_profile(graph.sensing).joint_channels)
     files = expand_paths(data)
     check_recordings(ckpt, files)
-    graph = graph_from_checkpoint(ckpt)
     rec = graph.relabel(load_recordings(files))
     rule = labels or str(ckpt["config"].get("labels", "last"))
     rec = label_windows(rec, int(ckpt["window"]), rule)
@@ -60,15 +76,41 @@ def score_checkpoint(
     )
     model = model_from_checkpoint(ckpt).to(dev)
     windows = make_windows(rec, int(ckpt["window"]), ckpt["config"].get("stride"))
-    return Scored(ckpt, graph, files, rec, windows, model, predict(model, tensors, windows))
+    predictions = predict(model, tensors, windows)
+    if observability == "motion":
+        moved = joints_moved(rec, windows)
+        predictions = _observable(predictions, moved, ckpt, ckpt["labels"]["classes"])
+    return Scored(ckpt, graph, files, rec, windows, model, predictions)
+
+
+def _observable(
+    predictions: Predictions, moved: np.ndarray, ckpt: dict[str, Any], classes: list[str]
+) -> Predictions:
+    """``predictions`` with their class logits replaced by the log of
+    :func:`hide_unobservable`'s probabilities (``moved [K, J]``)."""
+    logits = predictions.class_logits.astype(np.float64)
+    probs = np.exp(logits - logits.max(axis=1, keepdims=True))
+    probs /= probs.sum(axis=1, keepdims=True)
+    joint = predictions.joint_logits.astype(np.float64)
+    if joint_score_kind(ckpt) == "softmax":
+        scores = np.exp(joint - joint.max(axis=1, keepdims=True))
+    else:
+        scores = 0.5 * (1.0 + np.tanh(0.5 * joint))
+    kept = hide_unobservable(probs, scores, moved, classes)
+    return replace(predictions, class_logits=np.log(np.maximum(kept, 1e-30)).astype(np.float32))
 
 
 def evaluate_checkpoint(
-    ckpt_path: Path | str, data: list[str] | str, device: str = "auto", labels: str | None = None
+    ckpt_path: Path | str,
+    data: list[str] | str,
+    device: str = "auto",
+    labels: str | None = None,
+    observability: str = "all",
 ) -> dict[str, Any]:
     """Rebuild the exact model from its checkpoint and score it on every window of ``data``
-    (labelled by ``labels``; default: the rule it was trained with)."""
-    scored = score_checkpoint(ckpt_path, data, device, labels)
+    (labelled by ``labels``; default: the rule it was trained with; ``observability``: as in
+    :func:`score_checkpoint`)."""
+    scored = score_checkpoint(ckpt_path, data, device, labels, observability)
     ckpt, graph, rec, model = scored.ckpt, scored.graph, scored.rec, scored.model
     files = scored.files
     metrics = metrics_of(scored.predictions, target_joint_moved(rec, scored.windows))
@@ -80,6 +122,7 @@ def evaluate_checkpoint(
         "data": [str(f) for f in files],
         "data_fingerprint": rec.fingerprint(),
         "labels": labels or str(ckpt["config"].get("labels", "last")),
+        "observability": observability,
         "best_epoch": ckpt["best_epoch"],
         "gamma": gamma_of(model),
         **coupling_report(model, graph),

@@ -6,7 +6,10 @@ sender's node order is the schema's). Every check is vectorised over the rows, e
 window lives in preallocated arrays (:mod:`robohealth_mj.runtime.incremental`), the model runs
 once per tick on every stream whose window is full, each stream's evidence accumulates over its
 windows (:mod:`robohealth_mj.runtime.evidence`; reset with the window on a gap), and the alarms
-update in bulk on the accumulated probabilities. A bad row
+update in bulk on the accumulated probabilities. With ``observability="motion"`` a stream's
+window calls friction and backlash only on joints that moved in it
+(:mod:`robohealth_mj.data.observability`; the last sample index at which each joint moved is
+kept per stream). A bad row
 never raises: it comes back flagged with its reason. Several rows from one stream in one tick
 (a burst) are taken in order, up to ``max_burst``; the rest are flagged and dropped.
 """
@@ -27,6 +30,8 @@ import numpy as np
 from robohealth_mj import schema
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.numeric import softmax
+from robohealth_mj.data.observability import MOVING_RAD_S, check_observability, hide_unobservable
+from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
@@ -38,6 +43,8 @@ log = logging.getLogger(__name__)
 DECIDED, WARMING, INVALID, NO_MODEL, BUFFERED = 0, 1, 2, 3, 4
 JOINT_SCORES = ("softmax", "sigmoid")  # how joint logits become scores (ONNX metadata)
 
+_NEVER = -(2**62)  # the sample index at which a joint that has not moved yet last moved
+_VEL = schema.feature_index("vel")
 _FLAGS = np.zeros((schema.N_NODES, 2), np.float32)
 _FLAGS[: schema.N_JOINTS, 0] = 1.0
 _FLAGS[schema.N_JOINTS :, 1] = 1.0
@@ -131,7 +138,9 @@ class FleetRuntime:
         shards: int = 1,
         chunk: int = 256,
         providers: Sequence[str] | None = None,
+        observability: str = "all",
     ) -> None:
+        self.observability = check_observability(observability)
         self.max_streams, self.max_burst = max_streams, max_burst
         self.chunk = max(1, chunk)
         self.max_gap_s, self.idle_ticks = max_gap_s, idle_ticks
@@ -141,6 +150,7 @@ class FleetRuntime:
         self.window, self.model_id, self.problem = 16, "none", None
         self.joint_scores = "softmax"
         self.arm = DEFAULT_ARM  # the arm whose raw readings the model takes
+        self.sensing = "full"  # the model's sensing profile (data/sensing.py)
         self.classes, self.joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
         self.engine: IncrementalEngine | WindowedEngine | None = None
         self.mode = "none"
@@ -150,11 +160,14 @@ class FleetRuntime:
 
             providers = execution_providers(providers, ort.get_available_providers())
         self._load(model_path, threads, incremental, capacity, providers)
+        if self.engine is not None and observability == "motion":  # the model must read motion
+            check_observability(observability, load_profile(self.sensing).joint_channels)
         self.alarms = AlarmBank(alarm or AlarmPolicy(), len(self.joints), capacity)
         self.evidence = EvidenceBank(evidence or EvidencePolicy(), len(self.classes), capacity)
         self.last_t = np.full(capacity, -np.inf)
         self.last_index = np.full(capacity, -1, np.int64)
         self.last_seen = np.zeros(capacity, np.int64)
+        self.last_moved = np.full((capacity, schema.N_JOINTS), _NEVER, np.int64)
         self.active = np.zeros(capacity, bool)
         self.ids: dict[str, int] = {}
         self.names: list[str | None] = [None] * capacity
@@ -225,6 +238,7 @@ class FleetRuntime:
 
         self.window = int(meta["window"])
         self.arm = meta.get("arm", DEFAULT_ARM)  # models exported before arms were data: UR5e
+        self.sensing = meta.get("sensing", "full")
         self.classes, self.joints = meta["classes"], meta["joints"]
         # models exported before the key existed were all trained with the softmax joint loss
         self.joint_scores = meta.get("joint_scores", "softmax")
@@ -278,6 +292,7 @@ class FleetRuntime:
         self.active[slot], self.names[slot], self.ids[sid] = True, sid, slot
         self.last_t[slot], self.last_index[slot] = -np.inf, -1
         self.last_seen[slot] = self.ticks
+        self.last_moved[slot] = _NEVER
         if self.engine is not None:
             self.engine.reset(np.array([slot]))
         self.alarms.reset(np.array([slot]))
@@ -293,6 +308,9 @@ class FleetRuntime:
         self.last_t = np.concatenate([self.last_t, np.full(n, -np.inf)])
         self.last_index = np.concatenate([self.last_index, np.full(n, -1, np.int64)])
         self.last_seen = np.concatenate([self.last_seen, np.zeros(n, np.int64)])
+        self.last_moved = np.concatenate(
+            [self.last_moved, np.full((n, schema.N_JOINTS), _NEVER, np.int64)]
+        )
         self.active = np.concatenate([self.active, np.zeros(n, bool)])
         self.names += [None] * n
 
@@ -388,7 +406,11 @@ class FleetRuntime:
         if gap.any():  # the window restarts, and the evidence with it
             self.engine.reset(gs[gap])
             self.evidence.reset(gs[gap])
+            self.last_moved[gs[gap]] = _NEVER
         self.last_t[gs], self.last_index[gs] = gt, gi
+        if self.observability == "motion":
+            fast = np.abs(x[good][:, : schema.N_JOINTS, _VEL]) > MOVING_RAD_S  # [g, J]
+            self.last_moved[gs] = np.where(fast, gi[:, None], self.last_moved[gs])
         self._clock.mark("validate, bookkeeping")
         start = time.perf_counter()
         decide = final[good]
@@ -409,6 +431,9 @@ class FleetRuntime:
             return elapsed
         probs = softmax(outputs[0])
         joint_scores = joint_scores_from_logits(outputs[1], self.joint_scores)
+        if self.observability == "motion":  # a joint moved within the window's W samples
+            moved = self.last_index[ready][:, None] - self.last_moved[ready] < self.window
+            probs = hide_unobservable(probs, joint_scores, moved, self.classes)
         accumulated = self.evidence.update(ready, probs)
         state, alarm, joint = self.alarms.update(ready, accumulated, joint_scores)
         target = rows[good][full]
@@ -473,6 +498,7 @@ class FleetRuntime:
             "mode": self.mode,
             "threads": self.threads,
             "joint_scores": self.joint_scores,
+            "observability": self.observability,
             "problem": self.problem,
         }
 

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.data.observability import MOVING_RAD_S
 from robohealth_mj.runtime.runtime import HealthDiagnosis
 from robohealth_mj.schema import FaultLabel
 from robohealth_mj.sim.arms import DEFAULT_ARM
@@ -62,7 +63,7 @@ class _Episode:
 
 
 # What a fault needs to show at all (see physically_hidden): motion for friction, load for weakening
-MOVED_SPEED = 0.05  # rad/s: 50 x the velocity noise floor
+MOVED_SPEED = MOVING_RAD_S  # rad/s: 50 x the velocity noise floor (windows, observability too)
 LOADED_SHARE = 0.05  # RMS torque as a share of the joint's rated torque
 
 

@@ -117,10 +117,12 @@ class ModelRuntime:
         alarm: AlarmPolicy | None = None,
         incremental: bool = True,
         evidence: EvidencePolicy | None = None,
+        observability: str = "all",
     ) -> None:
         self.fleet = FleetRuntime(
-            model_path, threads=threads, alarm=alarm, evidence=evidence, incremental=incremental
-        )
+            model_path, threads=threads, alarm=alarm, evidence=evidence, incremental=incremental,
+            observability=observability,
+        )  # fmt: skip
         self._queue: list[tuple[int, GraphSample]] = []
 
     @property

@@ -7,10 +7,12 @@ import pytest
 
 from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.data.graphs import harness_graph
-from robohealth_mj.data.windows import make_windows
+from robohealth_mj.data.observability import hide_unobservable
+from robohealth_mj.data.windows import joints_moved, make_windows
 from robohealth_mj.learn.checkpoint import load_checkpoint, model_from_checkpoint
 from robohealth_mj.learn.evaluation import (
     evaluate_checkpoint,
+    score_checkpoint,
     score_under_placement,
     validation_windows,
 )
@@ -44,3 +46,33 @@ def test_a_told_placement_is_set_in_the_model_and_validation_is_its_own_runs(dep
     every = make_windows(train, int(ckpt["window"]))
     assert 0 < told["windows"] == len(val.end) < len(every.end)
     assert {np.asarray(train.run_ids)[train.run[e]] for e in val.end} <= runs
+
+
+def test_motion_observability_calls_friction_and_backlash_only_where_a_joint_moved(deployed):
+    """Per window, as the monitor does per tick: the model's belief in a motion-only fault on
+    the joints that stood still goes to none; windows in which every joint moved are unchanged."""
+    ckpt, held = deployed["structural_ckpt"], str(deployed["heldout"])
+    plain = score_checkpoint(ckpt, held, "cpu")
+    gated = score_checkpoint(ckpt, held, "cpu", observability="motion")
+    moved = joints_moved(plain.rec, plain.windows)
+    still, every = ~moved.any(axis=1), moved.all(axis=1)
+    assert (~every).sum() > len(every) // 4  # sweeps leave some joints still in most windows
+
+    def probs(logits):
+        e = np.exp(logits - logits.max(axis=1, keepdims=True))
+        return e / e.sum(axis=1, keepdims=True)
+
+    joint = probs(plain.predictions.joint_logits.astype(np.float64))
+    classes = plain.ckpt["labels"]["classes"]
+    want = hide_unobservable(probs(plain.predictions.class_logits), joint, moved, classes)
+    np.testing.assert_allclose(probs(gated.predictions.class_logits), want, atol=1e-5)
+    calls = gated.predictions.class_logits.argmax(1)
+    motion_only = [classes.index("backlash"), classes.index("friction")]
+    assert not np.isin(calls[still], motion_only).any()
+    before = plain.predictions.class_logits.argmax(1)
+    assert (np.isin(calls, motion_only) <= np.isin(before, motion_only)).all()  # only fewer
+    assert (np.isin(calls, motion_only) < np.isin(before, motion_only)).any()  # ... and some
+    np.testing.assert_array_equal(calls[every], before[every])
+    result = evaluate_checkpoint(ckpt, held, "cpu", observability="motion")
+    assert result["observability"] == "motion"
+    assert result["metrics"]["windows"] == len(calls)

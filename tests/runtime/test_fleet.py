@@ -389,7 +389,7 @@ def test_sharded_steps_decide_as_one_shard_does(deployed):
     assert (r.status == DECIDED).all()
     assert two.describe() == {
         "model_id": one.model_id, "arm": "ur5e", "window": 8, "mode": "incremental", "threads": 1,
-        "joint_scores": "softmax", "problem": None,
+        "joint_scores": "softmax", "observability": "all", "problem": None,
     }  # fmt: skip
     assert one.model_id.startswith("stgnn_fixed-structural-w8-")
 
@@ -643,7 +643,8 @@ def test_joint_scores_keep_the_faulted_joint_when_every_logit_is_large():
 
 
 def test_the_export_records_how_joint_scores_were_trained(deployed):
-    from robohealth_mj.deploy.export import joint_score_kind, read_metadata
+    from robohealth_mj.deploy.export import read_metadata
+    from robohealth_mj.learn.checkpoint import joint_score_kind
 
     assert joint_score_kind({"config": {"trainer": {"joint_softmax": False}}}) == "sigmoid"
     assert joint_score_kind({"config": {"trainer": {"joint_softmax": True}}}) == "softmax"
@@ -679,3 +680,46 @@ def test_bench_streams_names_an_unknown_provider_in_one_line(deployed, capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("bench: error: execution provider 'NoSuch' is not in this onnxruntime")
     assert len(err.splitlines()) == 1
+
+
+def test_motion_observability_hides_friction_on_joints_still_through_the_window(deployed):
+    """One joint turns at a single sample; windows holding that sample keep the model's calls,
+    every other window (the arm still) has friction and backlash handed to none."""
+    from robohealth_mj.data.observability import MOVING_RAD_S, hide_unobservable
+
+    rec = load_recordings([deployed["heldout"]])
+    ticks, spike = 90, 40
+    x = rec.x[:ticks].copy()
+    vel = schema.feature_index("vel")
+    x[:, :, vel] = 0.0  # the arm still (the same input to both runtimes) ...
+    x[spike, 2, vel] = 1.2 * MOVING_RAD_S  # ... but the elbow, at one sample
+    plain = FleetRuntime(deployed["structural_onnx"])
+    gated = FleetRuntime(deployed["structural_onnx"], observability="motion")
+    assert gated.describe()["observability"] == "motion"
+    a, b = plain.register(["s"]), gated.register(["s"])
+    w, seen = plain.window, 0
+    motion_only = [plain.classes.index(c) for c in ("backlash", "friction")]
+    for t in range(ticks):
+        ra = plain.step(a, [t], [0.05 * (t + 1)], x[t : t + 1])
+        rb = gated.step(b, [t], [0.05 * (t + 1)], x[t : t + 1])
+        if ra.status[0] != DECIDED:
+            continue
+        moved = np.zeros((1, 6), bool)
+        moved[0, 2] = spike <= t <= spike + w - 1  # the spike lies in the window ending at t
+        want = hide_unobservable(ra.probs, ra.joint_scores, moved, plain.classes)
+        np.testing.assert_allclose(rb.probs, want, atol=1e-6)
+        if not moved.any():
+            assert (rb.probs[0, motion_only] == 0).all()
+        else:
+            seen += 1
+            assert rb.probs[0, motion_only].sum() > 0 or ra.probs[0, motion_only].sum() == 0
+    assert seen == w  # exactly the W windows that hold the spike
+
+
+def test_the_monitor_refuses_an_unknown_observability(deployed, capsys):
+    with pytest.raises(SystemExit) as info:
+        monitor_main([f"model={deployed['structural_onnx']}", "observability=moving"])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("monitor: error: observability must be one of"), err
+    assert len(err.strip().splitlines()) == 1
