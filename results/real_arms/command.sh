@@ -75,3 +75,6 @@ $PY experiments/real_arms/observability_cost.py > results/real_arms/observabilit
 for obs in all motion; do
   $PY experiments/real_arms/events.py --run standard --suffix _rate0.99 --observability $obs; echo
 done > results/real_arms/events_observability.md
+for run in standard standard_s43 standard_s44; do  # what the rule leaves on point-to-point motion
+  $PY experiments/real_arms/calls_left.py --run $run; echo
+done > results/real_arms/calls_left.md
