@@ -51,8 +51,11 @@ def joints_moved(rec: Recording, windows: Windows, threshold: float = MOVING_RAD
     """``[K, J]``: each joint turned faster than ``threshold`` at some tick of each window (what
     :mod:`robohealth_mj.data.observability` calls *moved*)."""
     rows = windows.start[:, None] + np.arange(windows.window)[None, :]  # [K, W]
-    speed = np.abs(rec.x[rows, :N_JOINTS, feature_index("vel")])  # [K, W, J]
-    return speed.max(axis=1) > threshold
+    vel = feature_index("vel")
+    # a joint at a time: a [K, W] gather, not [K, W, J] (a whole corpus at stride 1)
+    return np.stack(
+        [np.abs(rec.x[rows, j, vel]).max(axis=1) > threshold for j in range(N_JOINTS)], axis=1
+    )
 
 
 def target_joint_moved(
