@@ -187,9 +187,11 @@ def simulated(log: Path, twin: Path, out: Path) -> Path:
     return graphs
 
 
-def share(model: Path, xs: list[np.ndarray], like: list[schema.GraphSample]) -> float:
+def share(
+    model: Path, xs: list[np.ndarray], like: list[schema.GraphSample], observability: str = "all"
+) -> float:
     """Share of decided ticks called faulty when the monitor reads ``xs`` in ``like``'s place."""
-    runtime = ModelRuntime(str(model))
+    runtime = ModelRuntime(str(model), observability=observability)
     decided = faulty = 0
     for x, s in zip(xs, like, strict=True):
         d = runtime.process("arm", schema.GraphSample(s.recording_run_id, s.sample_index, s.t, x,
@@ -200,14 +202,15 @@ def share(model: Path, xs: list[np.ndarray], like: list[schema.GraphSample]) -> 
     return faulty / max(decided, 1)
 
 
-def swap_table(run_name: str, variant: str, suffix: str) -> None:
+def swap_table(run_name: str, variant: str, suffix: str, observability: str = "all") -> None:
     """Prints the channel-swap table (see ``--swap``) for ``variant`` of run ``run_name``."""
     models = ROOT / run_name / "models"
     model = next(p for p in models.rglob(f"commissioned{suffix}/model.onnx") if variant in p.parts)
     twin = ROOT / "twin" / "twin.yaml"
     residual = schema.feature_index("effort_residual")
     short = ("pan", "lift", "elbow", "w1", "w2", "w3")
-    print(f"## Channel swaps: {variant}, run {run_name} (share of ticks called faulty)\n")
+    print(f"## Channel swaps: {variant}, run {run_name}{suffix}, observability={observability} "
+          "(share of ticks called faulty)\n")  # fmt: skip
     heads = [f"real, sim {c}" for c in CHANNELS] + [f"real, sim residual {j}" for j in short]
     print("| log | real | sim, same motion | " + " | ".join(heads) + " |")
     print("|---" * (3 + len(heads)) + "|")
@@ -219,14 +222,19 @@ def swap_table(run_name: str, variant: str, suffix: str) -> None:
         at = np.clip(np.searchsorted(t_sim, t_real - 1e-6), 0, len(sim) - 1)
         real_x = [s.x for s in real]
         sim_x = [sim[k].x for k in at]
-        cells = [share(model, real_x, real), share(model, sim_x, real)]
+        cells = [
+            share(model, real_x, real, observability),
+            share(model, sim_x, real, observability),
+        ]
         for c in CHANNELS:
             f = schema.feature_index(c)
             cells.append(share(model, [_swap(r, s, slice(0, 6), f) for r, s in
-                                       zip(real_x, sim_x, strict=True)], real))  # fmt: skip
+                                       zip(real_x, sim_x, strict=True)], real,
+                               observability))  # fmt: skip
         for j in range(schema.N_JOINTS):
             cells.append(share(model, [_swap(r, s, slice(j, j + 1), residual) for r, s in
-                                       zip(real_x, sim_x, strict=True)], real))  # fmt: skip
+                                       zip(real_x, sim_x, strict=True)], real,
+                               observability))  # fmt: skip
         print(f"| {log.stem} | " + " | ".join(f"{v:.2f}" for v in cells)
               + " |")  # fmt: skip
 
@@ -288,7 +296,7 @@ def main() -> None:
         f"_rate{args.healthy_rate:g}" if args.healthy_rate else ""
     )
     if args.swap:
-        swap_table(name, args.swap, suffix)
+        swap_table(name, args.swap, suffix, args.observability)
         return
     if not LOGS.is_dir():
         raise SystemExit(f"no logs in {LOGS}: run experiments/real_arms/fetch.sh")

@@ -78,3 +78,5 @@ done > results/real_arms/events_observability.md
 for run in standard standard_s43 standard_s44; do  # what the rule leaves on point-to-point motion
   $PY experiments/real_arms/calls_left.py --run $run; echo
 done > results/real_arms/calls_left.md
+$PY experiments/real_arms/campaign.py --curriculum standard --swap stgnn_fixed --healthy-rate 0.99 \
+  --observability motion > results/real_arms/swap_channels_observability.md
