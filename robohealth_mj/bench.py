@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> None:
     sim.add_argument(
         "--arms",
         default=None,
-        help="comma-separated arms (ur3e,ur5e,ur10e,ur16e) measured back to back in this run, "
+        help="comma-separated arms (ur3e,ur5e,ur10e,ur16e,ur20) measured back to back in this run, "
         "each recorder's throughput against the first's",
     )
     sim.add_argument("overrides", nargs="*", help="Hydra overrides for conf/record.yaml")

@@ -56,7 +56,7 @@ def dh_gravity_torques(dh: dict, q: np.ndarray, payload_kg: float = 0.0) -> np.n
     return tau
 
 
-ARMS = ("ur3e", "ur5e", "ur10e", "ur16e")
+ARMS = ("ur3e", "ur5e", "ur10e", "ur16e", "ur20")
 POSES = {
     "home": HOME_POSE,
     "zero": np.zeros(6),
@@ -65,7 +65,7 @@ POSES = {
 }
 
 
-def test_the_four_e_series_arms_ship():
+def test_the_e_series_arms_ship():
     assert set(ARMS) <= set(known_arms())
 
 
