@@ -138,3 +138,21 @@ $PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_x2 
 { $PY experiments/arms/localisation_errors.py; echo
   $PY experiments/arms/localisation_errors.py --out outputs/campaign_arms_x2 \
     --corpus outputs/corpus/arms_x2; } > results/arms/localisation_errors.md
+# 7. (2026-11-27) The UR20 (assets/ur20/): its corpus and the UR5e's again (the own-model recipe
+#    of table_full_e10.md: seed 42, networks 10 epochs), each arm's own models side by side, the
+#    UR20 left out of a model trained on the four other arms (before and after commissioning,
+#    false alarms over its healthy hour), and its recorder speed (bench_sim_ur20.txt)
+for arm in ur20 ur5e ur3e ur10e ur16e; do
+  [ -f outputs/corpus/arms/$arm/corpus.json ] || $PY -m robohealth_mj.corpus corpus=arms \
+    out_dir=outputs/corpus/arms/$arm "record_overrides=[\"arm=$arm\"]" progress=false
+done
+U="$C --out outputs/campaign_arms_ur20 --seeds 42"
+$U --arms ur5e,ur20 --stages own --variants gbdt --override model.severity=false --steps train
+$U --arms ur5e,ur20 --stages own --variants stgnn_fixed --epochs 10 --steps train
+$U --arms ur20 --stages loao --variants gbdt --override model.severity=false \
+  --steps train,commission
+$U --arms ur20 --stages loao --variants stgnn_fixed --epochs 10 \
+  --steps train,rescore,commission,alarms
+$PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_ur20 \
+  > results/arms/table_ur20.md
+$PY -m robohealth_mj.bench sim --duration 60 --arms ur5e,ur20,ur5e,ur20
