@@ -76,3 +76,19 @@ def test_motion_observability_calls_friction_and_backlash_only_where_a_joint_mov
     result = evaluate_checkpoint(ckpt, held, "cpu", observability="motion")
     assert result["observability"] == "motion"
     assert result["metrics"]["windows"] == len(calls)
+
+
+def test_evaluate_refuses_an_unknown_observability_in_one_line(deployed):
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, "-m", "robohealth_mj.evaluate", f"ckpt={deployed['structural_ckpt']}",
+         f"data={deployed['heldout']}", "observability=moving"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert lines == [
+        "evaluate: error: observability must be one of ['all', 'motion'], got 'moving'"
+    ]
