@@ -88,7 +88,8 @@ def test_evaluate_refuses_an_unknown_observability_in_one_line(deployed):
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     assert done.returncode == 2
-    lines = done.stderr.strip().splitlines()
-    assert lines == [
+    assert "Traceback" not in done.stderr
+    errors = [line for line in done.stderr.splitlines() if "error" in line]
+    assert errors == [
         "evaluate: error: observability must be one of ['all', 'motion'], got 'moving'"
     ]
