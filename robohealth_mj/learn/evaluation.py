@@ -13,6 +13,7 @@ import torch
 
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
+from robohealth_mj.common.numeric import joint_scores_from_logits, softmax
 from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
 from robohealth_mj.data.observability import check_observability, hide_unobservable
 from robohealth_mj.data.sensing import load_profile
@@ -64,9 +65,10 @@ def score_checkpoint(
     (:mod:`robohealth_mj.data.observability`), as the monitor does with the same setting."""
     ckpt = load_checkpoint(ckpt_path)
     graph = graph_from_checkpoint(ckpt)
-    check_observability(observability)
-    if observability == "motion":  # the model must read the joints' velocity
-        check_observability(observability, load_profile(graph.sensing).joint_channels)
+    motion = observability == "motion"  # then the model must read the joints' velocity
+    check_observability(
+        observability, load_profile(graph.sensing).joint_channels if motion else None
+    )
     files = expand_paths(data)
     check_recordings(ckpt, files)
     rec = graph.relabel(load_recordings(files))
@@ -81,23 +83,19 @@ def score_checkpoint(
     predictions = predict(model, tensors, windows)
     if observability == "motion":
         moved = joints_moved(rec, windows)
-        predictions = _observable(predictions, moved, ckpt, ckpt["labels"]["classes"])
+        kind = joint_score_kind(ckpt)
+        predictions = _observable(predictions, moved, kind, ckpt["labels"]["classes"])
     return Scored(ckpt, graph, files, rec, windows, model, predictions)
 
 
 def _observable(
-    predictions: Predictions, moved: np.ndarray, ckpt: dict[str, Any], classes: list[str]
+    predictions: Predictions, moved: np.ndarray, kind: str, classes: list[str]
 ) -> Predictions:
     """``predictions`` with their class logits replaced by the log of
-    :func:`hide_unobservable`'s probabilities (``moved [K, J]``)."""
-    logits = predictions.class_logits.astype(np.float64)
-    probs = np.exp(logits - logits.max(axis=1, keepdims=True))
-    probs /= probs.sum(axis=1, keepdims=True)
-    joint = predictions.joint_logits.astype(np.float64)
-    if joint_score_kind(ckpt) == "softmax":
-        scores = np.exp(joint - joint.max(axis=1, keepdims=True))
-    else:
-        scores = 0.5 * (1.0 + np.tanh(0.5 * joint))
+    :func:`hide_unobservable`'s probabilities (``moved [K, J]``; ``kind``: how the joint logits
+    were trained, :func:`joint_score_kind`)."""
+    probs = softmax(predictions.class_logits.astype(np.float64))
+    scores = joint_scores_from_logits(predictions.joint_logits.astype(np.float64), kind)
     kept = hide_unobservable(probs, scores, moved, classes)
     return replace(predictions, class_logits=np.log(np.maximum(kept, 1e-30)).astype(np.float32))
 

@@ -29,7 +29,7 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.common.numeric import softmax
+from robohealth_mj.common.numeric import joint_scores_from_logits, softmax
 from robohealth_mj.data.observability import MOVING_RAD_S, check_observability, hide_unobservable
 from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
@@ -91,14 +91,6 @@ def freeze_startup_heap() -> None:
     would land inside some tick; a long-running runtime process calls this once after start-up."""
     gc.collect()
     gc.freeze()
-
-
-def joint_scores_from_logits(logits: np.ndarray, kind: str) -> np.ndarray:
-    """``[B, J]`` joint logits -> scores as the model was trained: ``softmax`` over the joints
-    (which joint is at fault) or ``sigmoid`` per joint (is this joint at fault)."""
-    if kind == "softmax":
-        return softmax(logits)
-    return 0.5 * (1.0 + np.tanh(0.5 * logits))  # sigmoid, no overflow
 
 
 PREFERRED_PROVIDERS = ("CUDAExecutionProvider", "CPUExecutionProvider")
