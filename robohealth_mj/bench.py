@@ -38,8 +38,9 @@ def main(argv: list[str] | None = None) -> None:
     sim.add_argument(
         "--arms",
         default=None,
-        help="comma-separated arms (ur3e,ur5e,ur10e,ur16e,ur20) measured back to back in this run, "
-        "each recorder's throughput against the first's",
+        help="comma-separated arms (ur3e,ur5e,ur10e,ur16e,ur20,ur30) measured back to back in this "
+        "run, each recorder's throughput against the first arm's latest reading (repeat the pair, "
+        "e.g. ur5e,ur30,ur5e,ur30, to bracket the machine's load)",
     )
     sim.add_argument("overrides", nargs="*", help="Hydra overrides for conf/record.yaml")
     models = sub.add_parser("models", help="parameters and batch-1 CPU latency per variant")

@@ -10,7 +10,7 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 git clone --quiet --depth 1 --branch "$ref" \
     https://github.com/UniversalRobots/Universal_Robots_ROS2_Description.git "$work/ur"
-for arm in ur3e ur5e ur10e ur16e ur20; do
+for arm in ur3e ur5e ur10e ur16e ur20 ur30; do
     mkdir -p "$root/assets/$arm/ur_description"
     for f in default_kinematics physical_parameters joint_limits; do
         cp "$work/ur/config/$arm/$f.yaml" "$root/assets/$arm/ur_description/$f.yaml"

@@ -4,7 +4,8 @@ real logs and monitor the arm's other real logs.
 
     experiments/real_arms/fetch.sh                   # the logs -> outputs/real_arms/logs/
     python experiments/real_arms/campaign.py [--curriculum standard|replay|mixed|programs|holds]
-        [--commission jointwise|jointwise+program] [--healthy-rate R] [--twin FILE] [--name RUN]
+        [--commission jointwise|jointwise+program|jointwise+own_motion] [--healthy-rate R]
+        [--twin FILE] [--name RUN]
         [--variants gbdt,stgnn_fixed] [--seed 42] [--epochs 10] [--labels last|visible]
         [--observability all|motion]
 
@@ -13,7 +14,9 @@ real logs and monitor the arm's other real logs.
 (``conf/corpus/replay.yaml``, ``curriculum=replay``); ``mixed`` on both corpora; ``programs`` on
 the standard sweeps and pendant-taught point-to-point programs (``pick_place`` family);
 ``holds`` on the standard sweeps and holds (``hold`` family: a move to a new pose, then held).
-``--commission`` names the healthy real running the models are commissioned on; ``--labels`` how
+``--commission`` names the healthy real running the models are commissioned on
+(``jointwise+own_motion``: also the first half of the point-to-point log, whose second half is
+then monitored in its place; verdicts in ``verdicts_ownmotion...``); ``--labels`` how
 training windows are labelled (``train labels=``; ``visible``: friction and backlash on a joint
 that stood still through the window, which nothing shows, as healthy); ``--stiction`` records the
 corpora with the twin's dry friction made to stick (``STICTION``); ``--observability motion``
@@ -98,7 +101,27 @@ LOGS_ROLES = {
 CURRICULA = {"standard": ["standard"], "replay": ["replay"], "mixed": ["standard", "replay"],
              "programs": ["programs"], "holds": ["holds"]}  # fmt: skip
 # the healthy real running each model is commissioned on
-COMMISSION = {"jointwise": ["commission"], "jointwise+program": ["commission", "program"]}
+COMMISSION = {"jointwise": ["commission"], "jointwise+program": ["commission", "program"],
+              "jointwise+own_motion": ["commission"]}  # fmt: skip
+# the verdicts' suffix per commissioning set
+COMMISSION_SUFFIX = {"jointwise": "", "jointwise+program": "_program",
+                     "jointwise+own_motion": "_ownmotion"}  # fmt: skip
+# The arm's own point-to-point program, the one motion our sweeps lack. A user commissions on
+# their arm's own running; this dataset has one such log, so --commission jointwise+own_motion
+# cuts it in two: commissioning reads its first half and the monitor its second.
+OWN_MOTION = VAL / "ur-20_01_17-ptp_10_points.csv"
+
+
+def halves(log: Path) -> tuple[Path, Path]:
+    """``log`` cut at its middle row into two logs of the same layout, under ``halves/``."""
+    out = ROOT / "halves"
+    first, second = out / f"{log.stem}_first_half.csv", out / f"{log.stem}_second_half.csv"
+    if not second.is_file():
+        rows = log.read_text().splitlines(keepends=True)
+        out.mkdir(parents=True, exist_ok=True)
+        first.write_text("".join(rows[: len(rows) // 2]))
+        second.write_text("".join(rows[len(rows) // 2 :]))
+    return first, second
 
 
 def healthy_monitored() -> list[Path]:
@@ -266,6 +289,12 @@ def main() -> None:
     parser.add_argument("--curriculum", choices=tuple(CURRICULA), default="replay")
     parser.add_argument("--commission", choices=tuple(COMMISSION), default="jointwise")
     parser.add_argument(
+        "--second-half",
+        action="store_true",
+        help="monitor the point-to-point log's second half in place of the whole, the logs that "
+        "--commission jointwise+own_motion monitors (verdicts<suffix>_half)",
+    )
+    parser.add_argument(
         "--twin",
         type=Path,
         default=None,
@@ -292,7 +321,7 @@ def main() -> None:
     args = parser.parse_args()  # fmt: skip
     name = args.name or args.curriculum
     # beside the jointwise ones at validation's healthy rate
-    suffix = ("" if args.commission == "jointwise" else "_program") + (
+    suffix = COMMISSION_SUFFIX[args.commission] + (
         f"_rate{args.healthy_rate:g}" if args.healthy_rate else ""
     )
     if args.swap:
@@ -316,8 +345,14 @@ def main() -> None:
             "trainer.progress=false",
             "hydra/launcher=local", f"hydra.sweep.dir={sweep}")  # fmt: skip
     commissioning = [p for role in COMMISSION[args.commission] for p in LOGS_ROLES[role]]
+    monitored = healthy_monitored()
+    if args.commission == "jointwise+own_motion" or args.second_half:
+        first, second = halves(OWN_MOTION)
+        commissioning += [first] if args.commission == "jointwise+own_motion" else []
+        monitored = [second if p == OWN_MOTION else p for p in monitored]
     gate = "_motion" if args.observability == "motion" else ""
-    verdicts = ROOT / name / f"verdicts{suffix}{gate}"
+    half = "_half" if args.second_half and args.commission != "jointwise+own_motion" else ""
+    verdicts = ROOT / name / f"verdicts{suffix}{half}{gate}"
     for ckpt in sorted(p for p in sweep.rglob("best.ckpt") if "commissioned" not in p.parent.name):
         variant = next(part for part in ckpt.parts if part in args.variants.split(","))
         done = ckpt.parent / f"commissioned{suffix}"
@@ -328,7 +363,7 @@ def main() -> None:
         # the program logs: healthy real running no run is judged on, so runs are compared on
         # it (selection); in-sample for the curricula that replay it
         targets = [("program", p) for p in LOGS_ROLES["program"]]
-        targets += [("healthy", p) for p in healthy_monitored()]
+        targets += [("healthy", p) for p in monitored]
         targets += [(kind, p) for kind, paths in events().items() for p in paths]
         for kind, log in targets:
             out = verdicts / variant / kind / f"{log.stem}.json"

@@ -156,3 +156,27 @@ $U --arms ur20 --stages loao --variants stgnn_fixed --epochs 10 \
 $PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_ur20 \
   > results/arms/table_ur20.md
 $PY -m robohealth_mj.bench sim --duration 60 --arms ur5e,ur20,ur5e,ur20
+# 8. (2026-11-27) The UR30 (assets/ur30/): its corpus, its own models and the four-arm models
+#    (the UR20's recipe) beside the UR5e's and UR20's rows of step 7 (table_ur30.md), and its
+#    recorder speed (bench_sim_ur30.txt)
+[ -f outputs/corpus/arms/ur30/corpus.json ] || $PY -m robohealth_mj.corpus corpus=arms \
+  out_dir=outputs/corpus/arms/ur30 "record_overrides=[\"arm=ur30\"]" progress=false
+$U --arms ur30 --stages own --variants gbdt --override model.severity=false --steps train
+$U --arms ur30 --stages own --variants stgnn_fixed --epochs 10 --steps train
+$U --arms ur30 --stages loao --variants gbdt --override model.severity=false \
+  --steps train,commission
+$U --arms ur30 --stages loao --variants stgnn_fixed --epochs 10 \
+  --steps train,rescore,commission,alarms
+for arm in ur20 ur30; do  # seeds 43 and 44 of both arms' own and four-arm models
+  $C --out outputs/campaign_arms_ur20 --seeds 43,44 --arms $arm --stages own --variants gbdt \
+    --override model.severity=false --steps train
+  $C --out outputs/campaign_arms_ur20 --seeds 43,44 --arms $arm --stages own \
+    --variants stgnn_fixed --epochs 10 --steps train
+  $C --out outputs/campaign_arms_ur20 --seeds 43,44 --arms $arm --stages loao --variants gbdt \
+    --override model.severity=false --steps train,commission
+  $C --out outputs/campaign_arms_ur20 --seeds 43,44 --arms $arm --stages loao \
+    --variants stgnn_fixed --epochs 10 --steps train,rescore,commission,alarms
+done
+$PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_ur20 \
+  > results/arms/table_ur30.md
+$PY -m robohealth_mj.bench sim --duration 60 --arms ur5e,ur30,ur5e,ur30,ur5e,ur30

@@ -80,3 +80,22 @@ for run in standard standard_s43 standard_s44; do  # what the rule leaves on poi
 done > results/real_arms/calls_left.md
 $PY experiments/real_arms/campaign.py --curriculum standard --swap stgnn_fixed --healthy-rate 0.99 \
   --observability motion > results/real_arms/swap_channels_observability.md
+# Curricula and commissioning with the rule (2026-11-27, fifteenth session): the point-to-point
+# programs and the holds in the curriculum again, now monitored with observability=motion, and
+# the standard models commissioned on the arm's own point-to-point motion as well (the first
+# half of that log; its second half is monitored instead): curricula_motion.md, own_motion.md,
+# swap_channels_programs.md; about 70 minutes on 2 cores with the standard runs above
+for curriculum in programs holds; do
+  $CAMPAIGN --curriculum $curriculum --healthy-rate 0.99 --observability motion
+done
+$PY experiments/real_arms/campaign.py --curriculum programs --swap stgnn_fixed --healthy-rate 0.99 \
+  --observability motion > results/real_arms/swap_channels_programs.md
+$PY experiments/real_arms/summarise.py --runs 'standard,programs,holds' > results/real_arms/curricula_motion.md
+for own in "--commission jointwise+own_motion" --second-half; do  # and the same logs without it
+  $CAMPAIGN --curriculum standard $own --healthy-rate 0.99 --observability motion
+  for seed in 43 44; do
+    $PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --epochs 10 \
+      --curriculum standard --name standard_s$seed $own --healthy-rate 0.99 --observability motion
+  done
+done
+$PY experiments/real_arms/summarise.py --runs 'standard,standard_s4*' > results/real_arms/own_motion.md

@@ -56,7 +56,7 @@ def dh_gravity_torques(dh: dict, q: np.ndarray, payload_kg: float = 0.0) -> np.n
     return tau
 
 
-ARMS = ("ur3e", "ur5e", "ur10e", "ur16e", "ur20")
+ARMS = ("ur3e", "ur5e", "ur10e", "ur16e", "ur20", "ur30")
 POSES = {
     "home": HOME_POSE,
     "zero": np.zeros(6),
