@@ -179,4 +179,4 @@ for arm in ur20 ur30; do  # seeds 43 and 44 of both arms' own and four-arm model
 done
 $PY experiments/arms/summarise.py --sensing full --out outputs/campaign_arms_ur20 \
   > results/arms/table_ur30.md
-$PY -m robohealth_mj.bench sim --duration 60 --arms ur5e,ur30,ur5e,ur30,ur5e,ur30
+$PY -m robohealth_mj.bench sim --duration 600 --arms ur5e,ur30,ur5e,ur30,ur5e,ur30
