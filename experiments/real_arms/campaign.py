@@ -48,6 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.common.atomic import atomic_write_text
 from robohealth_mj.runtime.runtime import ModelRuntime
 from robohealth_mj.runtime.sources import replay_stream
 
@@ -116,11 +117,11 @@ def halves(log: Path) -> tuple[Path, Path]:
     """``log`` cut at its middle row into two logs of the same layout, under ``halves/``."""
     out = ROOT / "halves"
     first, second = out / f"{log.stem}_first_half.csv", out / f"{log.stem}_second_half.csv"
-    if not second.is_file():
+    if not (first.is_file() and second.is_file()):
         rows = log.read_text().splitlines(keepends=True)
         out.mkdir(parents=True, exist_ok=True)
-        first.write_text("".join(rows[: len(rows) // 2]))
-        second.write_text("".join(rows[len(rows) // 2 :]))
+        atomic_write_text(first, "".join(rows[: len(rows) // 2]))
+        atomic_write_text(second, "".join(rows[len(rows) // 2 :]))
     return first, second
 
 
