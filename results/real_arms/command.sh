@@ -99,3 +99,7 @@ for own in "--commission jointwise+own_motion" --second-half; do  # and the same
   done
 done
 $PY experiments/real_arms/summarise.py --runs 'standard,standard_s4*' > results/real_arms/own_motion.md
+for run in standard standard_s43 standard_s44; do  # the calls left, and the moves at constant speed
+  $PY experiments/real_arms/calls_left.py --run $run --suffix _ownmotion_rate0.99 \
+    --log ../halves/ur-20_01_17-ptp_10_points_second_half.csv; echo
+done > results/real_arms/calls_left_cruise.md
