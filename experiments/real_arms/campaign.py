@@ -3,7 +3,8 @@ corpus on the twin, train the stock_reduced profile's models on it, commission t
 real logs and monitor the arm's other real logs.
 
     experiments/real_arms/fetch.sh                   # the logs -> outputs/real_arms/logs/
-    python experiments/real_arms/campaign.py [--curriculum standard|replay|mixed|programs|holds]
+    python experiments/real_arms/campaign.py [--curriculum standard|replay|mixed|programs|holds|
+        mixed_own_motion]
         [--commission jointwise|jointwise+program|jointwise+own_motion] [--healthy-rate R]
         [--twin FILE] [--name RUN]
         [--variants gbdt,stgnn_fixed] [--seed 42] [--epochs 10] [--labels last|visible]
@@ -13,7 +14,8 @@ real logs and monitor the arm's other real logs.
 ``replay`` on the arm's own program: the ``program`` logs replayed on the twin with no payload
 (``conf/corpus/replay.yaml``, ``curriculum=replay``); ``mixed`` on both corpora; ``programs`` on
 the standard sweeps and pendant-taught point-to-point programs (``pick_place`` family);
-``holds`` on the standard sweeps and holds (``hold`` family: a move to a new pose, then held).
+``holds`` on the standard sweeps and holds (``hold`` family: a move to a new pose, then held);
+``mixed_own_motion`` on the standard sweeps and the first half of the point-to-point log replayed.
 ``--commission`` names the healthy real running the models are commissioned on
 (``jointwise+own_motion``: also the first half of the point-to-point log, whose second half is
 then monitored in its place; verdicts in ``verdicts_ownmotion...``); ``--labels`` how
@@ -100,17 +102,14 @@ LOGS_ROLES = {
 
 # the corpora each curriculum trains on (the last one's held-out session is the one evaluated)
 CURRICULA = {"standard": ["standard"], "replay": ["replay"], "mixed": ["standard", "replay"],
-             "programs": ["programs"], "holds": ["holds"]}  # fmt: skip
+             "programs": ["programs"], "holds": ["holds"],
+             "mixed_own_motion": ["standard", "replay_own_motion"]}  # fmt: skip
 # the healthy real running each model is commissioned on
 COMMISSION = {"jointwise": ["commission"], "jointwise+program": ["commission", "program"],
               "jointwise+own_motion": ["commission"]}  # fmt: skip
 # the verdicts' suffix per commissioning set
 COMMISSION_SUFFIX = {"jointwise": "", "jointwise+program": "_program",
                      "jointwise+own_motion": "_ownmotion"}  # fmt: skip
-# The arm's own point-to-point program, the one motion our sweeps lack. A user commissions on
-# their arm's own running; this dataset has one such log, so --commission jointwise+own_motion
-# cuts it in two: commissioning reads its first half and the monitor its second.
-OWN_MOTION = VAL / "ur-20_01_17-ptp_10_points.csv"
 
 
 def halves(log: Path) -> tuple[Path, Path]:
@@ -158,6 +157,13 @@ def as_list(paths: list[Path]) -> str:
     return "[" + ",".join(str(p) for p in paths) + "]"
 
 
+# The arm's own point-to-point program, the one motion our sweeps lack. A user commissions on
+# their arm's own running; this dataset has one such log, so --commission jointwise+own_motion
+# cuts it in two: commissioning reads its first half and the monitor its second
+# (--curriculum mixed_own_motion also replays the first half on the twin in training).
+OWN_MOTION = VAL / "ur-20_01_17-ptp_10_points.csv"
+OWN_MOTION_FIRST = ROOT / "halves" / f"{OWN_MOTION.stem}_first_half.csv"
+
 # each corpus: its config and what its sessions add to the twin's record overrides
 CORPORA = {
     "standard": ("quick", []),
@@ -170,6 +176,11 @@ CORPORA = {
     "programs": ("quick", ["curriculum.families=[single_joint,joint_pair,whole_arm,pick_place]"]),
     # the standard sweeps and holds: one move from rest to a new pose, then the pose held
     "holds": ("quick", ["curriculum.families=[single_joint,joint_pair,whole_arm,hold]"]),
+    # the first half of the arm's own point-to-point program replayed (see OWN_MOTION)
+    "replay_own_motion": (
+        "replay",
+        ["curriculum=replay", f"curriculum.files=[{OWN_MOTION_FIRST}]"],
+    ),
 }
 
 
@@ -335,6 +346,7 @@ def main() -> None:
         run("robohealth_mj.identify", "arm=ur10e", f"fit={as_list(LOGS_ROLES['fit'])}",
             f"validate={as_list(LOGS_ROLES['validate'])}", f"out={twin.parent}")  # fmt: skip
     tag = f"_{args.twin.stem}" if args.twin else ""
+    halves(OWN_MOTION)  # the replay_own_motion corpus replays its first half
     corpora = [record_corpus(c, twin, tag, args.stiction) for c in CURRICULA[args.curriculum]]
     train = ",".join(f"{c}/train_*" for c in corpora)
     sweep = ROOT / name / "models"

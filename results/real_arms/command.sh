@@ -98,7 +98,11 @@ for own in "--commission jointwise+own_motion" --second-half; do  # and the same
       --curriculum standard --name standard_s$seed $own --healthy-rate 0.99 --observability motion
   done
 done
-$PY experiments/real_arms/summarise.py --runs 'standard,standard_s4*' > results/real_arms/own_motion.md
+# and the same motion in training too: the twin replays the log's first half beside the sweeps
+$CAMPAIGN --curriculum mixed_own_motion --commission jointwise+own_motion --healthy-rate 0.99 \
+  --observability motion
+$PY experiments/real_arms/summarise.py --runs 'standard,standard_s4*,mixed_own_motion' \
+  > results/real_arms/own_motion.md
 for run in standard standard_s43 standard_s44; do  # the calls left, and the moves at constant speed
   $PY experiments/real_arms/calls_left.py --run $run --suffix _ownmotion_rate0.99 \
     --log ../halves/ur-20_01_17-ptp_10_points_second_half.csv; echo
