@@ -59,8 +59,8 @@ def main() -> None:
     runtime = ModelRuntime(str(model), observability=args.observability)
     samples = [s for _, s, _ in replay_stream(str(LOGS / args.log))]
     said = [runtime.process("arm", s) for s in samples]
-    speed = np.abs(np.stack([s.x[: schema.N_JOINTS, schema.feature_index("vel")] for s in samples]))
     vel = np.stack([s.x[: schema.N_JOINTS, schema.feature_index("vel")] for s in samples])
+    speed = np.abs(vel)
     calls, moving = Counter(), Counter()
     cruise = {True: [0, 0], False: [0, 0]}  # a joint cruised in the window: [decided, faulty]
     for k, d in enumerate(said):

@@ -112,18 +112,6 @@ COMMISSION_SUFFIX = {"jointwise": "", "jointwise+program": "_program",
                      "jointwise+own_motion": "_ownmotion"}  # fmt: skip
 
 
-def halves(log: Path) -> tuple[Path, Path]:
-    """``log`` cut at its middle row into two logs of the same layout, under ``halves/``."""
-    out = ROOT / "halves"
-    first, second = out / f"{log.stem}_first_half.csv", out / f"{log.stem}_second_half.csv"
-    if not (first.is_file() and second.is_file()):
-        rows = log.read_text().splitlines(keepends=True)
-        out.mkdir(parents=True, exist_ok=True)
-        atomic_write_text(first, "".join(rows[: len(rows) // 2]))
-        atomic_write_text(second, "".join(rows[len(rows) // 2 :]))
-    return first, second
-
-
 def healthy_monitored() -> list[Path]:
     """The healthy real logs without payload that neither commission nor are replayed: unseen
     excitation runs, a free motion, a run after unloading, point-to-point moves and ten holds."""
@@ -162,7 +150,26 @@ def as_list(paths: list[Path]) -> str:
 # cuts it in two: commissioning reads its first half and the monitor its second
 # (--curriculum mixed_own_motion also replays the first half on the twin in training).
 OWN_MOTION = VAL / "ur-20_01_17-ptp_10_points.csv"
-OWN_MOTION_FIRST = ROOT / "halves" / f"{OWN_MOTION.stem}_first_half.csv"
+
+
+def half_paths(log: Path) -> tuple[Path, Path]:
+    """Where :func:`halves` writes ``log``'s first and second half."""
+    out = ROOT / "halves"
+    return out / f"{log.stem}_first_half.csv", out / f"{log.stem}_second_half.csv"
+
+
+def halves(log: Path) -> tuple[Path, Path]:
+    """``log`` cut at its middle row into two logs of the same layout (written once)."""
+    first, second = half_paths(log)
+    if not (first.is_file() and second.is_file()):
+        rows = log.read_text().splitlines(keepends=True)
+        first.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(first, "".join(rows[: len(rows) // 2]))
+        atomic_write_text(second, "".join(rows[len(rows) // 2 :]))
+    return first, second
+
+
+OWN_MOTION_FIRST, _ = half_paths(OWN_MOTION)
 
 # each corpus: its config and what its sessions add to the twin's record overrides
 CORPORA = {
@@ -346,7 +353,7 @@ def main() -> None:
         run("robohealth_mj.identify", "arm=ur10e", f"fit={as_list(LOGS_ROLES['fit'])}",
             f"validate={as_list(LOGS_ROLES['validate'])}", f"out={twin.parent}")  # fmt: skip
     tag = f"_{args.twin.stem}" if args.twin else ""
-    halves(OWN_MOTION)  # the replay_own_motion corpus replays its first half
+    first, second = halves(OWN_MOTION)  # the replay_own_motion corpus replays the first half
     corpora = [record_corpus(c, twin, tag, args.stiction) for c in CURRICULA[args.curriculum]]
     train = ",".join(f"{c}/train_*" for c in corpora)
     sweep = ROOT / name / "models"
@@ -360,7 +367,6 @@ def main() -> None:
     commissioning = [p for role in COMMISSION[args.commission] for p in LOGS_ROLES[role]]
     monitored = healthy_monitored()
     if args.commission == "jointwise+own_motion" or args.second_half:
-        first, second = halves(OWN_MOTION)
         commissioning += [first] if args.commission == "jointwise+own_motion" else []
         monitored = [second if p == OWN_MOTION else p for p in monitored]
     gate = "_motion" if args.observability == "motion" else ""
