@@ -4,7 +4,7 @@ real logs and monitor the arm's other real logs.
 
     experiments/real_arms/fetch.sh                   # the logs -> outputs/real_arms/logs/
     python experiments/real_arms/campaign.py [--curriculum standard|replay|mixed|programs|holds|
-        mixed_own_motion]
+        cruise|mixed_own_motion]
         [--commission jointwise|jointwise+program|jointwise+own_motion] [--healthy-rate R]
         [--twin FILE] [--name RUN]
         [--variants gbdt,stgnn_fixed] [--seed 42] [--epochs 10] [--labels last|visible]
@@ -15,6 +15,8 @@ real logs and monitor the arm's other real logs.
 (``conf/corpus/replay.yaml``, ``curriculum=replay``); ``mixed`` on both corpora; ``programs`` on
 the standard sweeps and pendant-taught point-to-point programs (``pick_place`` family);
 ``holds`` on the standard sweeps and holds (``hold`` family: a move to a new pose, then held);
+``cruise`` on the standard sweeps and cruising moves (``cruise`` family: long synchronised joint
+moves at a constant speed, as a UR controller runs point-to-point programs);
 ``mixed_own_motion`` on the standard sweeps and the first half of the point-to-point log replayed.
 ``--commission`` names the healthy real running the models are commissioned on
 (``jointwise+own_motion``: also the first half of the point-to-point log, whose second half is
@@ -102,7 +104,7 @@ LOGS_ROLES = {
 
 # the corpora each curriculum trains on (the last one's held-out session is the one evaluated)
 CURRICULA = {"standard": ["standard"], "replay": ["replay"], "mixed": ["standard", "replay"],
-             "programs": ["programs"], "holds": ["holds"],
+             "programs": ["programs"], "holds": ["holds"], "cruise": ["cruise"],
              "mixed_own_motion": ["standard", "replay_own_motion"]}  # fmt: skip
 # the healthy real running each model is commissioned on
 COMMISSION = {"jointwise": ["commission"], "jointwise+program": ["commission", "program"],
@@ -183,6 +185,9 @@ CORPORA = {
     "programs": ("quick", ["curriculum.families=[single_joint,joint_pair,whole_arm,pick_place]"]),
     # the standard sweeps and holds: one move from rest to a new pose, then the pose held
     "holds": ("quick", ["curriculum.families=[single_joint,joint_pair,whole_arm,hold]"]),
+    # the standard sweeps and cruising moves: long joint moves at a constant speed, as a UR
+    # controller runs its point-to-point programs
+    "cruise": ("quick", ["curriculum.families=[single_joint,joint_pair,whole_arm,cruise]"]),
     # the first half of the arm's own point-to-point program replayed (see OWN_MOTION)
     "replay_own_motion": (
         "replay",
@@ -372,8 +377,11 @@ def main() -> None:
     gate = "_motion" if args.observability == "motion" else ""
     half = "_half" if args.second_half and args.commission != "jointwise+own_motion" else ""
     verdicts = ROOT / name / f"verdicts{suffix}{half}{gate}"
+    wanted = args.variants.split(",")
     for ckpt in sorted(p for p in sweep.rglob("best.ckpt") if "commissioned" not in p.parent.name):
-        variant = next(part for part in ckpt.parts if part in args.variants.split(","))
+        variant = next((part for part in ckpt.parts if part in wanted), None)
+        if variant is None:  # a model of this run that --variants leaves out
+            continue
         done = ckpt.parent / f"commissioned{suffix}"
         if not (done / "best.ckpt").is_file():
             run("robohealth_mj.commission", f"model={ckpt}", "arm=ur10e",

@@ -107,3 +107,36 @@ for run in standard standard_s43 standard_s44; do  # the calls left, and the mov
   $PY experiments/real_arms/calls_left.py --run $run --suffix _ownmotion_rate0.99 \
     --log ../halves/ur-20_01_17-ptp_10_points_second_half.csv; echo
 done > results/real_arms/calls_left_cruise.md
+# Cruising moves (2026-11-27, sixteenth session): the standard sweeps plus the cruise family (long
+# joint moves that hold a constant speed, every joint starting and stopping together, as the arm's
+# point-to-point program runs), commissioned on the joint-wise logs and on the arm's own motion, at
+# three seeds; then what the quiet costs: the cruise models at looser operating points, the
+# standard model at stricter ones, and per fault class on the twin's held-out session:
+# cruise.md, calls_left_cruise_family.md, sensitivity.md; about 60 minutes on 2 cores
+for own in "" "--commission jointwise+own_motion"; do
+  # shellcheck disable=SC2086  # $own is empty or two words
+  $CAMPAIGN --curriculum cruise $own --healthy-rate 0.99 --observability motion
+  for seed in 43 44; do
+    # shellcheck disable=SC2086
+    $PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --epochs 10 \
+      --curriculum cruise --name cruise_s$seed $own --healthy-rate 0.99 --observability motion
+  done
+done
+for point in "cruise --healthy-rate 0.97" "cruise --healthy-rate 0.98" cruise \
+  "standard --healthy-rate 0.995" "standard --healthy-rate 0.998" standard; do
+  # shellcheck disable=SC2086  # a curriculum and its operating point (none: validation's rate)
+  $PY experiments/real_arms/campaign.py --variants stgnn_fixed --commission jointwise+own_motion \
+    --observability motion --curriculum $point
+done
+$PY experiments/real_arms/summarise.py --runs 'standard,standard_s4*,cruise,cruise_s4*' \
+  > results/real_arms/cruise.md
+for run in cruise cruise_s43 cruise_s44; do  # the calls left; whether a cruising window is one
+  $PY experiments/real_arms/calls_left.py --run $run --suffix _ownmotion_rate0.99 \
+    --log ../halves/ur-20_01_17-ptp_10_points_second_half.csv --corpus outputs/corpus/real_ur10e_cruise
+  echo
+done > results/real_arms/calls_left_cruise_family.md
+for seed in 42 43 44; do
+  runs=standard,cruise; [ $seed = 42 ] || runs=standard_s$seed,cruise_s$seed
+  $PY experiments/real_arms/sensitivity.py --runs $runs --seed $seed --suffix _ownmotion_rate0.99
+  echo
+done > results/real_arms/sensitivity.md

@@ -1,8 +1,10 @@
 """The trajectory curriculum (thesis §2.3.2): sweeps, coordinated pairs and whole-arm motion;
 and, for probing programs unlike those, pick-and-place and palletising cycles as taught on a
 pendant (point-to-point moves with dwells, family ``pick_place``); and holds (family ``hold``: one
-move from rest to a new pose, then the arm holds it, as a real arm spends much of its day). The
-last two are not in the default families.
+move from rest to a new pose, then the arm holds it, as a real arm spends much of its day); and
+cruising moves (family ``cruise``: long joint moves as a UR controller runs them, every joint
+accelerating, holding a constant speed and braking together, the way real point-to-point programs
+move). The last three are not in the default families.
 
 Speed scales multiply the base excitation frequency; payload scales multiply a nominal payload.
 Segments are shuffled per pass by the session seed. Each segment starts at the previous segment's
@@ -22,12 +24,20 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import N_JOINTS
 from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 
-FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place", "hold")
+FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place", "hold", "cruise")
 WAVEFORMS = ("sine", "triangle", "compound")
 TASKS = ("pick_place", "palletise")  # the pick_place family's programs
 LEG_S = 0.8  # the shortest point-to-point move at speed scale 1, s
 JOINT_SPEED = 1.0  # rad/s: the fastest joint's peak speed in a move at speed scale 1 (a UR5e's)
 LIFT_RAD = (0.0, -0.25, 0.35, -0.1, 0.0, 0.0)  # from a pick or place pose to above it
+# Family cruise, measured on a real UR10e's point-to-point program (results/real_arms/, the
+# ptp_10_points log): the leading joint reaches 0.70 rad/s in 0.67 s, cruises 0.9-5.2 s, brakes
+# alike, and the next move starts 0.03-0.05 s after the last one stops.
+CRUISE_SPEED = 0.7  # rad/s, the leading joint's cruise at speed scale 1
+CRUISE_RAMP_S = 0.67  # s, from rest to cruise (and back), at every speed scale
+CRUISE_DWELL_S = 0.1  # s, between the two moves of a segment
+CRUISE_STROKE_RAD = (1.5, 0.3, 0.5, 1.0, 1.2, 2.0)  # the via pose: centre + U(-1, 1) x this
+CRUISE_REPEATS = 3  # segments per speed and payload (each visit draws its own via pose)
 
 
 def _raw_waveform(name: str, phi: np.ndarray) -> np.ndarray:
@@ -56,6 +66,43 @@ def smoothstep(u: np.ndarray) -> np.ndarray:
     """The quintic from 0 to 1 on [0, 1] with zero slope and curvature at both ends."""
     u = np.clip(u, 0.0, 1.0)
     return u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
+
+
+def _smoothstep_integral(u: np.ndarray) -> np.ndarray:
+    """The integral of ``smoothstep`` from 0 to ``u`` (0.5 at 1)."""
+    u = np.clip(u, 0.0, 1.0)
+    return u**4 * (2.5 + u * (-3.0 + u))
+
+
+def cruise_profile(u: np.ndarray, ramp: float) -> np.ndarray:
+    """Progress from 0 to 1 over normalised time ``u`` in [0, 1]: speed rises along a smoothstep
+    for the first ``ramp`` of the move (at most 0.5), holds constant, and falls alike; an S-curve
+    version of a controller's trapezoidal profile, C2 so the reference stays smooth."""
+    u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
+    top = 1.0 / (1.0 - ramp)  # the cruise speed that covers the distance in unit time
+
+    def rising(x: np.ndarray) -> np.ndarray:
+        return top * np.where(
+            x < ramp, ramp * _smoothstep_integral(x / ramp), 0.5 * ramp + x - ramp
+        )
+
+    return np.where(u <= 0.5, rising(u), 1.0 - rising(1.0 - u))
+
+
+def cruise_timing(distance: np.ndarray, speed: float) -> tuple[float, float]:
+    """A synchronised joint move's duration (s) and ramp share: each joint's time at ``speed``
+    with ``CRUISE_RAMP_S`` ramps (a short move never reaches ``speed``: the same acceleration, no
+    cruise), and every joint follows the slowest one's profile, so all start and stop together."""
+    distance = np.abs(np.asarray(distance, dtype=float))
+    cruising = distance >= speed * CRUISE_RAMP_S
+    # short moves: peak speed sqrt(d v / t_r), reached after d / peak, braking as long
+    short = 2.0 * np.sqrt(distance * CRUISE_RAMP_S / speed)
+    duration = np.where(cruising, CRUISE_RAMP_S + distance / speed, short)
+    lead = int(np.argmax(duration))
+    total = float(duration[lead])
+    if total <= 0.0:
+        return 0.0, 0.5
+    return total, (CRUISE_RAMP_S / total if cruising[lead] else 0.5)
 
 
 @dataclass(frozen=True)
@@ -167,6 +214,8 @@ class Curriculum:
             )
         for speed, payload in itertools.product(speeds, payloads):
             out.append(Segment(len(out), "hold", "rest", tuple(range(N_JOINTS)), speed, payload))
+        for _, speed, payload in itertools.product(range(CRUISE_REPEATS), speeds, payloads):
+            out.append(Segment(len(out), "cruise", "movej", tuple(range(N_JOINTS)), speed, payload))
         return [s for s in out if s.family in self.families]
 
     def __len__(self) -> int:
@@ -230,6 +279,44 @@ class Curriculum:
             t0 += leg + dwell
         return out
 
+    def via_pose(self, visit: int) -> np.ndarray:
+        """A cruise segment's turning pose ``[6]``: its centre plus a seeded draw within
+        ``CRUISE_STROKE_RAD``, so the two moves (start to via, via to centre) are long; drawn in
+        towards the midpoint of start and centre until both moves fit 95 % of the segment."""
+        sched = self.scheduled(visit)
+        rng = np.random.default_rng([self.seed, 4, visit])
+        via = sched.center + rng.uniform(-1.0, 1.0, N_JOINTS) * np.asarray(CRUISE_STROKE_RAD)
+        middle = 0.5 * (sched.start_pose + sched.center)
+        while sum(d for d, _ in self._cruise_timings(visit, via)) > self._cruise_room():
+            via = middle + 0.9 * (via - middle)
+        return via
+
+    def _cruise_room(self) -> float:
+        return 0.95 * self.segment_s - CRUISE_DWELL_S
+
+    def _cruise_timings(self, visit: int, via: np.ndarray) -> list[tuple[float, float]]:
+        sched = self.scheduled(visit)
+        speed = CRUISE_SPEED * sched.segment.speed_scale
+        return [
+            cruise_timing(via - sched.start_pose, speed),
+            cruise_timing(sched.center - via, speed),
+        ]
+
+    def _cruise(self, visit: int, tau: np.ndarray) -> np.ndarray:
+        """Two synchronised joint moves at the segment's cruise speed, start to via to centre,
+        ``CRUISE_DWELL_S`` apart, then at rest."""
+        sched = self.scheduled(visit)
+        via = self.via_pose(visit)
+        poses = np.stack([sched.start_pose, via, sched.center])
+        out = np.repeat(poses[:1], len(tau), axis=0)
+        t0 = 0.0
+        for k, (duration, ramp) in enumerate(self._cruise_timings(visit, via)):
+            if duration > 0.0:
+                u = cruise_profile((tau[:, 0] - t0) / duration, ramp)[:, None]
+                out = out + (poses[k + 1] - poses[k]) * u
+            t0 += duration + CRUISE_DWELL_S
+        return out
+
     def _amplitude(self, segment: Segment) -> np.ndarray:
         factor = {
             "single_joint": 1.0,
@@ -257,6 +344,8 @@ class Curriculum:
         tau = np.asarray(t, dtype=float)[:, None] - sched.t_start
         if seg.family == "pick_place":
             return self._point_to_point(visit, tau)
+        if seg.family == "cruise":
+            return self._cruise(visit, tau)
         if seg.family == "hold":  # one move, blend_s long at speed scale 1, then the pose held
             move = smoothstep(tau * seg.speed_scale / self.blend_s)
             return sched.start_pose + (sched.center - sched.start_pose) * move

@@ -126,3 +126,45 @@ def test_holds_move_once_from_rest_to_a_new_pose_and_hold_it(record_cfg):
         assert np.abs(qd).max() <= SPEED_LIMIT
     default = _curriculum(record_cfg, seed=5)
     assert "hold" not in {s.family for s in default.segments}
+
+
+def test_cruise_moves_hold_a_constant_speed_together_and_stop_at_rest(record_cfg, model):
+    """Family cruise (the way a UR controller runs point-to-point moves): two moves a segment,
+    start to via to centre, every joint starting and stopping together; the leading joint holds
+    the segment's cruise speed for more than a 1.6 s window at speed scale 1 somewhere in the
+    family; within the speed limit, clear of contacts, smooth into the next segment; the default
+    families leave it out."""
+    from robohealth_mj.sim.curriculum import CRUISE_SPEED
+
+    c = _curriculum(record_cfg, "curriculum.families=[cruise]", seed=6)
+    assert len(c) == 27 and {s.family for s in c.segments} == {"cruise"}
+    data, index = mujoco.MjData(model), ArmIndex.of(model)
+    q_all, longest_cruise = [], 0.0
+    for visit in range(2 * len(c)):
+        sched = c.scheduled(visit)
+        t = sched.t_start + np.arange(0.0, c.segment_s, 0.002)
+        q, qd, _ = c.reference(visit, t)
+        q_all.append(q)
+        speed = CRUISE_SPEED * sched.segment.speed_scale
+        assert np.abs(qd).max() <= speed * 1.001
+        np.testing.assert_allclose(q[0], sched.start_pose, atol=1e-9)
+        np.testing.assert_allclose(q[-1], sched.center, atol=1e-9)
+        via = c.via_pose(visit)
+        turn = int(np.argmin(np.abs(q - via).max(axis=1)))
+        assert np.abs(q[turn] - via).max() < 1e-6  # it turns at the via
+        for a, b, part in ((sched.start_pose, via, q[:turn]), (via, sched.center, q[turn:])):
+            moved = np.abs(b - a) > 1e-3  # every joint that moves is as far along as the others
+            progress = (part[:, moved] - a[moved]) / (b - a)[moved]
+            np.testing.assert_allclose(progress, progress[:, :1].repeat(moved.sum(), 1), atol=1e-9)
+        if sched.segment.speed_scale == 1.0:
+            at_speed = np.abs(qd).max(axis=1) > 0.99 * speed
+            runs = np.diff(np.flatnonzero(np.diff(np.r_[0, at_speed, 0])))[::2]
+            longest_cruise = max(longest_cruise, runs.max(initial=0) * 0.002)
+        for pose in q[::50]:
+            index.set_link_pose(data, pose)
+            mujoco.mj_kinematics(model, data)
+            mujoco.mj_collision(model, data)
+            assert data.ncon == 0, (visit, pose)
+    assert longest_cruise > 1.6
+    assert np.abs(np.diff(np.concatenate(q_all), axis=0)).max() < SPEED_LIMIT * 0.002 * 1.01
+    assert "cruise" not in {s.family for s in _curriculum(record_cfg, seed=6).segments}
