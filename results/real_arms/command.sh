@@ -128,6 +128,10 @@ for point in "cruise --healthy-rate 0.97" "cruise --healthy-rate 0.98" cruise \
   $PY experiments/real_arms/campaign.py --variants stgnn_fixed --commission jointwise+own_motion \
     --observability motion --curriculum $point
 done
+for seed in 43 44; do  # the looser point at the other seeds
+  $PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --name cruise_s$seed \
+    --commission jointwise+own_motion --observability motion --curriculum cruise --healthy-rate 0.97
+done
 $PY experiments/real_arms/summarise.py --runs 'standard,standard_s4*,cruise,cruise_s4*' \
   > results/real_arms/cruise.md
 for run in cruise cruise_s43 cruise_s44; do  # the calls left; whether a cruising window is one
