@@ -8,6 +8,15 @@
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
 CAMPAIGN="$PY experiments/real_arms/campaign.py --variants gbdt,stgnn_fixed --seed 42 --epochs 10"
+three_seeds() {  # a curriculum and options: seed 42 as $CAMPAIGN, seeds 43 and 44 stgnn_fixed only
+  local curriculum=$1
+  shift
+  $CAMPAIGN --curriculum "$curriculum" "$@"
+  for seed in 43 44; do
+    $PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --epochs 10 \
+      --curriculum "$curriculum" --name "${curriculum}_s$seed" "$@"
+  done
+}
 [ -d outputs/real_arms/logs ] || experiments/real_arms/fetch.sh
 for f in outputs/real_arms/logs/*/*.csv; do   # which logs ingest, with which profile
   if out=$($PY -m robohealth_mj.ingest "$f" --out "outputs/real_arms/ingested/$(basename "$f" .csv)" 2>&1); then
@@ -91,13 +100,8 @@ done
 $PY experiments/real_arms/campaign.py --curriculum programs --swap stgnn_fixed --healthy-rate 0.99 \
   --observability motion > results/real_arms/swap_channels_programs.md
 $PY experiments/real_arms/summarise.py --runs 'standard,programs,holds' > results/real_arms/curricula_motion.md
-for own in "--commission jointwise+own_motion" --second-half; do  # and the same logs without it
-  $CAMPAIGN --curriculum standard $own --healthy-rate 0.99 --observability motion
-  for seed in 43 44; do
-    $PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --epochs 10 \
-      --curriculum standard --name standard_s$seed $own --healthy-rate 0.99 --observability motion
-  done
-done
+three_seeds standard --commission jointwise+own_motion --healthy-rate 0.99 --observability motion
+three_seeds standard --second-half --healthy-rate 0.99 --observability motion  # without it
 # and the same motion in training too: the twin replays the log's first half beside the sweeps
 $CAMPAIGN --curriculum mixed_own_motion --commission jointwise+own_motion --healthy-rate 0.99 \
   --observability motion
@@ -113,15 +117,8 @@ done > results/real_arms/calls_left_cruise.md
 # three seeds; then what the quiet costs: the cruise models at looser operating points, the
 # standard model at stricter ones, and per fault class on the twin's held-out session:
 # cruise.md, calls_left_cruise_family.md, sensitivity.md; about 60 minutes on 2 cores
-for own in "" "--commission jointwise+own_motion"; do
-  # shellcheck disable=SC2086  # $own is empty or two words
-  $CAMPAIGN --curriculum cruise $own --healthy-rate 0.99 --observability motion
-  for seed in 43 44; do
-    # shellcheck disable=SC2086
-    $PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --epochs 10 \
-      --curriculum cruise --name cruise_s$seed $own --healthy-rate 0.99 --observability motion
-  done
-done
+three_seeds cruise --healthy-rate 0.99 --observability motion
+three_seeds cruise --commission jointwise+own_motion --healthy-rate 0.99 --observability motion
 for point in "cruise --healthy-rate 0.97" "cruise --healthy-rate 0.98" cruise \
   "standard --healthy-rate 0.995" "standard --healthy-rate 0.998" standard; do
   # shellcheck disable=SC2086  # a curriculum and its operating point (none: validation's rate)
