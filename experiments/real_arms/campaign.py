@@ -4,7 +4,7 @@ real logs and monitor the arm's other real logs.
 
     experiments/real_arms/fetch.sh                   # the logs -> outputs/real_arms/logs/
     python experiments/real_arms/campaign.py [--curriculum standard|replay|mixed|programs|holds|
-        cruise|mixed_own_motion]
+        cruise|cruise_heavy|mixed_own_motion]
         [--commission jointwise|jointwise+program|jointwise+own_motion] [--healthy-rate R]
         [--twin FILE] [--name RUN]
         [--variants gbdt,stgnn_fixed] [--seed 42] [--epochs 10] [--labels last|visible]
@@ -16,7 +16,8 @@ real logs and monitor the arm's other real logs.
 the standard sweeps and pendant-taught point-to-point programs (``pick_place`` family);
 ``holds`` on the standard sweeps and holds (``hold`` family: a move to a new pose, then held);
 ``cruise`` on the standard sweeps and cruising moves (``cruise`` family: long synchronised joint
-moves at a constant speed, as a UR controller runs point-to-point programs);
+moves at a constant speed, as a UR controller runs point-to-point programs); ``cruise_heavy``
+the same with three times the cruising segments;
 ``mixed_own_motion`` on the standard sweeps and the first half of the point-to-point log replayed.
 ``--commission`` names the healthy real running the models are commissioned on
 (``jointwise+own_motion``: also the first half of the point-to-point log, whose second half is
@@ -105,6 +106,7 @@ LOGS_ROLES = {
 # the corpora each curriculum trains on (the last one's held-out session is the one evaluated)
 CURRICULA = {"standard": ["standard"], "replay": ["replay"], "mixed": ["standard", "replay"],
              "programs": ["programs"], "holds": ["holds"], "cruise": ["cruise"],
+             "cruise_heavy": ["cruise_heavy"],
              "mixed_own_motion": ["standard", "replay_own_motion"]}  # fmt: skip
 # the healthy real running each model is commissioned on
 COMMISSION = {"jointwise": ["commission"], "jointwise+program": ["commission", "program"],
@@ -188,6 +190,14 @@ CORPORA = {
     # the standard sweeps and cruising moves: long joint moves at a constant speed, as a UR
     # controller runs its point-to-point programs
     "cruise": ("quick", ["curriculum.families=[single_joint,joint_pair,whole_arm,cruise]"]),
+    # the same, three times the cruising segments (81 of 207 instead of 27 of 153)
+    "cruise_heavy": (
+        "quick",
+        [
+            "curriculum.families=[single_joint,joint_pair,whole_arm,cruise]",
+            "+curriculum.cruise_repeats=9",
+        ],
+    ),
     # the first half of the arm's own point-to-point program replayed (see OWN_MOTION)
     "replay_own_motion": (
         "replay",

@@ -37,7 +37,7 @@ CRUISE_SPEED = 0.7  # rad/s, the leading joint's cruise at speed scale 1
 CRUISE_RAMP_S = 0.67  # s, from rest to cruise (and back), at every speed scale
 CRUISE_DWELL_S = 0.1  # s, between the two moves of a segment
 CRUISE_STROKE_RAD = (1.5, 0.3, 0.5, 1.0, 1.2, 2.0)  # the via pose: centre + U(-1, 1) x this
-CRUISE_REPEATS = 3  # segments per speed and payload (each visit draws its own via pose)
+CRUISE_REPEATS = 3  # default segments per speed and payload (each visit draws its own via pose)
 
 
 def _raw_waveform(name: str, phi: np.ndarray) -> np.ndarray:
@@ -150,6 +150,7 @@ class Curriculum:
         reference_speed_rad_s: float = np.pi,
         rated_payload_kg: float | None = None,
         speed_limit_rad_s: Sequence[float] | None = None,
+        cruise_repeats: int = CRUISE_REPEATS,
     ) -> None:
         """``payload_fraction`` of the arm's rated payload is the nominal payload the payload
         scales multiply; ``amplitude_rad`` is for a joint whose speed limit is
@@ -193,6 +194,9 @@ class Curriculum:
         if unknown or not families:
             raise InputError(f"curriculum.families must be a non-empty subset of {FAMILIES}")
         self.families = tuple(families)
+        if int(cruise_repeats) < 1:
+            raise InputError(f"curriculum.cruise_repeats must be at least 1, got {cruise_repeats}")
+        self.cruise_repeats = int(cruise_repeats)
         self.seed = int(seed)
         self.segments = self._enumerate()
         self._cache: dict[int, ScheduledSegment] = {}
@@ -214,7 +218,7 @@ class Curriculum:
             )
         for speed, payload in itertools.product(speeds, payloads):
             out.append(Segment(len(out), "hold", "rest", tuple(range(N_JOINTS)), speed, payload))
-        for _, speed, payload in itertools.product(range(CRUISE_REPEATS), speeds, payloads):
+        for _, speed, payload in itertools.product(range(self.cruise_repeats), speeds, payloads):
             out.append(Segment(len(out), "cruise", "movej", tuple(range(N_JOINTS)), speed, payload))
         return [s for s in out if s.family in self.families]
 

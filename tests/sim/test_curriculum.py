@@ -168,3 +168,18 @@ def test_cruise_moves_hold_a_constant_speed_together_and_stop_at_rest(record_cfg
     assert longest_cruise > 1.6
     assert np.abs(np.diff(np.concatenate(q_all), axis=0)).max() < SPEED_LIMIT * 0.002 * 1.01
     assert "cruise" not in {s.family for s in _curriculum(record_cfg, seed=6).segments}
+
+
+def test_cruise_repeats_sets_the_familys_weight_and_refuses_none(record_cfg):
+    """``+curriculum.cruise_repeats=N``: N cruise segments per speed and payload (default 3), so
+    a corpus can weigh cruising motion; fewer than one is a one-line error."""
+    import pytest
+
+    from robohealth_mj.common.errors import user_error
+
+    six = _curriculum(record_cfg, "curriculum.families=[cruise]", "+curriculum.cruise_repeats=6")
+    assert len(six) == 54 and {s.family for s in six.segments} == {"cruise"}
+    with pytest.raises(Exception) as caught:
+        _curriculum(record_cfg, "curriculum.families=[cruise]", "+curriculum.cruise_repeats=0")
+    line = str(user_error(caught.value))  # what every command prints, exit status 2
+    assert "cruise_repeats must be at least 1, got 0" in line and "\n" not in line
