@@ -116,9 +116,11 @@ done > results/real_arms/calls_left_cruise.md
 # point-to-point program runs), commissioned on the joint-wise logs and on the arm's own motion, at
 # three seeds; then what the quiet costs: the cruise models at looser operating points, the
 # standard model at stricter ones, and per fault class on the twin's held-out session:
-# cruise.md, calls_left_cruise_family.md, sensitivity.md; about 60 minutes on 2 cores
+# cruise.md, calls_left_cruise_family.md, sensitivity.md; about 90 minutes on 2 cores
 three_seeds cruise --healthy-rate 0.99 --observability motion
 three_seeds cruise --commission jointwise+own_motion --healthy-rate 0.99 --observability motion
+# three times the cruising segments (+curriculum.cruise_repeats=9)
+three_seeds cruise_heavy --commission jointwise+own_motion --healthy-rate 0.99 --observability motion
 for point in "cruise --healthy-rate 0.97" "cruise --healthy-rate 0.98" cruise \
   "standard --healthy-rate 0.995" "standard --healthy-rate 0.998" standard; do
   # shellcheck disable=SC2086  # a curriculum and its operating point (none: validation's rate)
@@ -129,7 +131,7 @@ for seed in 43 44; do  # the looser point at the other seeds
   $PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --name cruise_s$seed \
     --commission jointwise+own_motion --observability motion --curriculum cruise --healthy-rate 0.97
 done
-$PY experiments/real_arms/summarise.py --runs 'standard,standard_s4*,cruise,cruise_s4*' \
+$PY experiments/real_arms/summarise.py --runs 'standard,standard_s4*,cruise,cruise_s4*,cruise_heavy,cruise_heavy_s4*' \
   > results/real_arms/cruise.md
 for run in cruise cruise_s43 cruise_s44; do  # the calls left; whether a cruising window is one
   $PY experiments/real_arms/calls_left.py --run $run --suffix _ownmotion_rate0.99 \
@@ -137,7 +139,8 @@ for run in cruise cruise_s43 cruise_s44; do  # the calls left; whether a cruisin
   echo
 done > results/real_arms/calls_left_cruise_family.md
 for seed in 42 43 44; do
-  runs=standard,cruise; [ $seed = 42 ] || runs=standard_s$seed,cruise_s$seed
+  runs=standard,cruise,cruise_heavy
+  [ $seed = 42 ] || runs=standard_s$seed,cruise_s$seed,cruise_heavy_s$seed
   $PY experiments/real_arms/sensitivity.py --runs $runs --seed $seed --suffix _ownmotion_rate0.99
   echo
 done > results/real_arms/sensitivity.md
