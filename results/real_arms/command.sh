@@ -117,6 +117,7 @@ done > results/real_arms/calls_left_cruise.md
 # three seeds; then what the quiet costs: the cruise models at looser operating points, the
 # standard model at stricter ones, and per fault class on the twin's held-out session:
 # cruise.md, calls_left_cruise_family.md, sensitivity.md; about 90 minutes on 2 cores
+$PY experiments/real_arms/moves.py > results/real_arms/moves.md  # how the arm's own moves run
 three_seeds cruise --healthy-rate 0.99 --observability motion
 three_seeds cruise --commission jointwise+own_motion --healthy-rate 0.99 --observability motion
 # three times the cruising segments (+curriculum.cruise_repeats=9)
