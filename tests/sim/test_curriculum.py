@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
+import pytest
 from hydra.utils import instantiate
 
+from robohealth_mj.common.errors import user_error
+from robohealth_mj.sim.curriculum import CRUISE_SPEED
 from robohealth_mj.sim.model import ArmIndex
 
 SPEED_LIMIT = 3.14  # rad/s, the UR5e joint speed limit (parameter file)
@@ -134,8 +137,6 @@ def test_cruise_moves_hold_a_constant_speed_together_and_stop_at_rest(record_cfg
     the segment's cruise speed for more than a 1.6 s window at speed scale 1 somewhere in the
     family; within the speed limit, clear of contacts, smooth into the next segment; the default
     families leave it out."""
-    from robohealth_mj.sim.curriculum import CRUISE_SPEED
-
     c = _curriculum(record_cfg, "curriculum.families=[cruise]", seed=6)
     assert len(c) == 27 and {s.family for s in c.segments} == {"cruise"}
     data, index = mujoco.MjData(model), ArmIndex.of(model)
@@ -173,10 +174,6 @@ def test_cruise_moves_hold_a_constant_speed_together_and_stop_at_rest(record_cfg
 def test_cruise_repeats_sets_the_familys_weight_and_refuses_none(record_cfg):
     """``+curriculum.cruise_repeats=N``: N cruise segments per speed and payload (default 3), so
     a corpus can weigh cruising motion; fewer than one is a one-line error."""
-    import pytest
-
-    from robohealth_mj.common.errors import user_error
-
     six = _curriculum(record_cfg, "curriculum.families=[cruise]", "+curriculum.cruise_repeats=6")
     assert len(six) == 54 and {s.family for s in six.segments} == {"cruise"}
     with pytest.raises(Exception) as caught:
