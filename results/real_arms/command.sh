@@ -120,6 +120,13 @@ done > results/real_arms/calls_left_cruise.md
 $PY experiments/real_arms/moves.py > results/real_arms/moves.md  # how the arm's own moves run
 three_seeds cruise --healthy-rate 0.99 --observability motion
 three_seeds cruise --commission jointwise+own_motion --healthy-rate 0.99 --observability motion
+for seed in 45 46; do  # two more seeds of both recipes, commissioned on the arm's own motion too
+  for curriculum in standard cruise; do
+    $PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --epochs 10 \
+      --curriculum $curriculum --name ${curriculum}_s$seed --commission jointwise+own_motion \
+      --healthy-rate 0.99 --observability motion
+  done
+done
 # three times the cruising segments (+curriculum.cruise_repeats=9)
 three_seeds cruise_heavy --commission jointwise+own_motion --healthy-rate 0.99 --observability motion
 for point in "cruise --healthy-rate 0.97" "cruise --healthy-rate 0.98" cruise \
@@ -134,12 +141,13 @@ for seed in 43 44; do  # the looser point at the other seeds
 done
 $PY experiments/real_arms/summarise.py --runs 'standard,standard_s4*,cruise,cruise_s4*,cruise_heavy,cruise_heavy_s4*' \
   > results/real_arms/cruise.md
-for run in cruise cruise_s43 cruise_s44; do  # the calls left; whether a cruising window is one
+# the calls left; whether a cruising window is one
+for run in cruise cruise_s43 cruise_s44 cruise_s45 cruise_s46 standard_s45 standard_s46; do
   $PY experiments/real_arms/calls_left.py --run $run --suffix _ownmotion_rate0.99 \
     --log ../halves/ur-20_01_17-ptp_10_points_second_half.csv --corpus outputs/corpus/real_ur10e_cruise
   echo
 done > results/real_arms/calls_left_cruise_family.md
-for seed in 42 43 44; do
+for seed in 42 43 44 45 46; do
   runs=standard,cruise,cruise_heavy
   [ $seed = 42 ] || runs=standard_s$seed,cruise_s$seed,cruise_heavy_s$seed
   $PY experiments/real_arms/sensitivity.py --runs $runs --seed $seed --suffix _ownmotion_rate0.99
