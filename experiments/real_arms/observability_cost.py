@@ -15,20 +15,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
+from robohealth_mj.learn.metrics import detection_rates
 
 ROOT = Path("outputs/real_arms")
 HELDOUT = "outputs/corpus/real_ur10e_standard/heldout_seed900"
-
-
-def rates(metrics: dict) -> tuple[float, float]:
-    """Healthy windows called a fault, faulted windows called a fault (any class)."""
-    cm = np.asarray(metrics["confusion_matrix"], float)
-    healthy = 1.0 - cm[0, 0] / max(cm[0].sum(), 1.0)
-    faulted = cm[1:, 1:].sum() / max(cm[1:].sum(), 1.0)
-    return healthy, faulted
 
 
 def main() -> None:
@@ -47,7 +38,7 @@ def main() -> None:
                 for rule in ("all", "motion"):
                     r = evaluate_checkpoint(ckpt, HELDOUT, "cpu", labels, rule)
                     m = r["metrics"]
-                    healthy, faulted = rates(m)
+                    healthy, faulted = detection_rates(m)
                     friction = m["per_class"].get("friction", {}).get("recall", float("nan"))
                     name = f"**{variant}**" if variant == "gbdt" else variant
                     where = ckpt.parent.name if "commissioned" in ckpt.parent.name else "trained"

@@ -17,10 +17,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-
 from robohealth_mj import schema
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
+from robohealth_mj.learn.metrics import detection_rates
 
 ROOT = Path("outputs/real_arms")
 HELDOUT = "outputs/corpus/real_ur10e_standard/heldout_seed900"
@@ -50,9 +49,7 @@ def main() -> None:
                     if not ckpt.is_file():
                         continue
                     m = evaluate_checkpoint(ckpt, HELDOUT, "cpu", "last", "motion")["metrics"]
-                    cm = np.asarray(m["confusion_matrix"], float)
-                    healthy = 1.0 - cm[0, 0] / max(cm[0].sum(), 1.0)
-                    faulted = cm[1:, 1:].sum() / max(cm[1:].sum(), 1.0)
+                    healthy, faulted = detection_rates(m)
                     recall = " | ".join(
                         f"{m['per_class'].get(c, {}).get('recall', float('nan')):.3f}"
                         for c in FAULTS

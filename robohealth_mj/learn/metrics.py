@@ -97,6 +97,15 @@ def compute_metrics(
     return result
 
 
+def detection_rates(metrics: dict[str, Any]) -> tuple[float, float]:
+    """From a metric set's confusion matrix: the share of healthy windows called any fault (the
+    false calls) and of faulted windows called any fault (the detections), whatever class."""
+    cm = np.asarray(metrics["confusion_matrix"], dtype=float)
+    healthy = 1.0 - cm[0, 0] / max(cm[0].sum(), 1.0)
+    faulted = cm[1:, 1:].sum() / max(cm[1:].sum(), 1.0)
+    return float(healthy), float(faulted)
+
+
 def flat_rows(metrics: dict[str, Any], prefix: str = "") -> list[tuple[str, Any]]:
     """Scalar metrics as ``(name, value)`` rows for CSV (nested dicts become dotted names)."""
     rows = []

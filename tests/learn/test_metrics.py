@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from robohealth_mj.data.graphs import DEFAULT_C0, coupling_correlation
-from robohealth_mj.learn.metrics import compute_metrics, flat_rows
+from robohealth_mj.learn.metrics import compute_metrics, detection_rates, flat_rows
 
 # eleven windows; classes: 0 none, 1 backlash, 3 jam, 5 sensor_drift, 6 sensor_noise (one
 # window); 2 and 4 absent. The first healthy window still carries its label's severity (a fault
@@ -152,3 +152,9 @@ def test_coupling_correlation_is_the_mean_of_row_correlations():
     assert coupling_correlation(one_row, np.array([[1.0, 2.0, 3.0, 5.0]])) == pytest.approx(
         np.corrcoef([1, 2, 3, 4], [1, 2, 3, 5])[0, 1]
     )
+
+
+def test_detection_rates_count_any_fault_class_as_a_detection(metrics):
+    """Of three healthy windows one is called backlash; of eight faulted windows six are called
+    some fault (the jam called drift counts), two are called none."""
+    assert detection_rates(metrics) == pytest.approx((1 / 3, 6 / 8))
