@@ -36,7 +36,8 @@ def main(argv: list[str] | None = None) -> None:
                             placement_prune=cfg.get("placement_prune"),
                             operating_point=cfg.operating_point,
                             arm=cfg.get("arm"),
-                            healthy_rate=cfg.get("healthy_rate"))  # fmt: skip
+                            healthy_rate=cfg.get("healthy_rate"),
+                            contact_margin=cfg.get("contact_margin"))  # fmt: skip
         atomic_write_json(out / "commissioning.json", record)
     print(f"{record['healthy_minutes']:g} healthy minutes -> {record['checkpoint']}")
     for row in record["settling"]:
@@ -73,6 +74,12 @@ def main(argv: list[str] | None = None) -> None:
             f"called a fault {point['validation_fault_recall_before']:.3f} -> "
             f"{point['validation_fault_recall_after']:.3f}"
         )
+    contact = record.get("contact", {})
+    if "threshold_nm" in contact:
+        values = " / ".join(f"{v:.2f}" for v in contact["threshold_nm"])
+        print(f"contact watch: thresholds {values} N·m ({contact['rule']})")
+    elif contact:
+        print(f"contact watch off: {contact['skipped']}")
     if "onnx" in record:
         print(f"exported -> {record['onnx']}")
 

@@ -21,6 +21,7 @@ from omegaconf import DictConfig
 from robohealth_mj.common.config import load_cli_config
 from robohealth_mj.common.errors import InputError, one_line_errors
 from robohealth_mj.runtime.alarms import AlarmPolicy
+from robohealth_mj.runtime.contact import ContactPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.metadata import read_metadata
 from robohealth_mj.runtime.monitor import monitor_stream, refuse_lacking_data
@@ -38,12 +39,14 @@ def main(argv: list[str] | None = None) -> dict | None:
     cfg = load_config(sys.argv[1:] if argv is None else argv)
     policy = _policy("alarm", AlarmPolicy, cfg)
     evidence = _policy("evidence", EvidencePolicy, cfg)
+    contact = _policy("contact", ContactPolicy, cfg)
     with one_line_errors("monitor"):
-        return _monitor(cfg, policy, evidence)
+        return _monitor(cfg, policy, evidence, contact)
 
 
 def _policy(key: str, kind: type, cfg: DictConfig):
-    """The ``alarm`` or ``evidence`` block as its policy; a bad value is the user's to fix."""
+    """The ``alarm``, ``evidence`` or ``contact`` block as its policy; a bad value is the user's
+    to fix."""
     with one_line_errors("monitor"):
         try:
             return kind(**cfg[key])
@@ -51,12 +54,14 @@ def _policy(key: str, kind: type, cfg: DictConfig):
             raise InputError(f"conf/monitor.yaml {key}: {exc}") from None
 
 
-def _monitor(cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy) -> dict | None:
+def _monitor(
+    cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy, contact: ContactPolicy
+) -> dict | None:
     if cfg.model:
         read_metadata(cfg.model)  # a model named but unusable is the user's to fix
     runtime = ModelRuntime(
         cfg.model, threads=cfg.threads, alarm=policy, incremental=cfg.incremental,
-        evidence=evidence, observability=cfg.observability,
+        evidence=evidence, observability=cfg.observability, contact=contact,
     )  # fmt: skip
     if cfg.source != "ros2":
         return monitor_stream(cfg, runtime, policy, evidence)

@@ -10,7 +10,10 @@ loads no joint beyond it).
 
 Per commissioned network (``outputs/real_arms/<run>/models/**/commissioned/model.onnx``), per
 push: when and how long, the share of its ticks called faulty, whether an alarm rose during it
-(or within a window after), the joint the monitor names most during it and the nearest joint.
+(or within a window after), the joint the monitor names most during it and the nearest joint;
+and what the contact watch says (:mod:`robohealth_mj.runtime.contact`, where the model carries
+its thresholds): the share of the push's ticks it calls a contact, how soon after the push's
+first tick, and the joint it names most.
 """
 
 from __future__ import annotations
@@ -22,30 +25,25 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj import schema
-from robohealth_mj.runtime.runtime import ModelRuntime
+from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 from robohealth_mj.runtime.sources import replay_stream
 from robohealth_mj.sim.ratings import rated_torque_nm
+from robohealth_mj.twin.pushes import nearest_joint, pushes
 
 LOGS = Path("outputs/real_arms/logs/collision")
 RESIDUAL = schema.feature_index("effort_residual")
+EFFORT = schema.feature_index("effort")
 TICK_HZ = 20.0
 
 
-def pushes(residual: np.ndarray, share: float) -> tuple[np.ndarray, list[tuple[int, int]]]:
-    """Per tick how far each joint's residual is off its level 1-3 s before, relative to its
-    rating ``[T, 6]``; the pushes as (first, last) ticks, gaps under 0.5 s merged."""
-    off = np.zeros_like(residual)
-    for t in range(25, len(residual)):  # the log's first second gives the first level
-        off[t] = np.abs(residual[t] - np.median(residual[max(0, t - 60) : t - 20], axis=0))
-    off /= rated_torque_nm("ur10e")
-    ticks = np.flatnonzero(off.max(axis=1) > share)
-    episodes: list[list[int]] = []
-    for t in ticks:
-        if episodes and t - episodes[-1][1] <= 10:
-            episodes[-1][1] = t
-        else:
-            episodes.append([t, t])
-    return off, [(a, b) for a, b in episodes if b - a >= 4]
+def contact_cells(during: list[HealthDiagnosis]) -> str:
+    """The contact watch over a push's ticks: share called, first call (s after the push's
+    first tick), the joint named most."""
+    called = [k for k, d in enumerate(during) if d.contact]
+    if not called:
+        return "0.00 | - | -"
+    named = Counter(during[k].contact_joint for k in called).most_common(1)[0][0]
+    return f"{len(called) / len(during):.2f} | {called[0] / TICK_HZ:.2f} | {named}"
 
 
 def main() -> None:
@@ -64,16 +62,20 @@ def main() -> None:
     print(f"A push: a joint's residual more than {args.share:.0%} of its rated torque off its "
           "level 1-3 s before.\n")  # fmt: skip
     print("| model | log | push at s | lasts s | called faulty | class called | alarm "
-          "| joint named | nearest joint |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| joint named | contact called | contact from s | contact joint "
+          "| nearest joint |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    moved: dict[str, np.ndarray] = {}
     for model in models:
         variant = model.parts[-5]  # <variant>/w32/seed42/commissioned/model.onnx
         for log in sorted(LOGS.glob("*.csv")):
             runtime = ModelRuntime(str(model), observability=args.observability)
             samples = [s for _, s, _ in replay_stream(str(log))]
             said = [runtime.process("arm", s) for s in samples]
-            off, found = pushes(np.stack([s.x[: schema.N_JOINTS, RESIDUAL] for s in samples]),
-                                args.share)  # fmt: skip
+            residual = np.stack([s.x[: schema.N_JOINTS, RESIDUAL] for s in samples])
+            expected = np.stack([s.x[: schema.N_JOINTS, EFFORT] for s in samples]) - residual
+            moved[log.stem] = np.ptp(expected, axis=0) / rated_torque_nm("ur10e")
+            off, found = pushes(residual, rated_torque_nm("ur10e"), args.share)
             for first, last in found:
                 during = said[first : last + 1]
                 faulty = [d for d in during if d.fault_present]
@@ -81,12 +83,16 @@ def main() -> None:
                 alarm = any(d.alarm == "raised" for d in after)
                 named = Counter(d.localised_joint for d in faulty).most_common(1)
                 called = Counter(d.fault_class for d in faulty).most_common(1)
-                loaded = np.flatnonzero(off[first : last + 1].max(axis=0) > args.share)
+                nearest = nearest_joint(off[first : last + 1], args.share)
                 print(f"| {variant} | {log.stem} | {first / TICK_HZ:.1f} | "
                       f"{(last - first + 1) / TICK_HZ:.1f} | {len(faulty) / len(during):.2f} | "
                       f"{called[0][0] if called else '-'} | {'yes' if alarm else 'no'} | "
-                      f"{named[0][0] if named else '-'} | "
-                      f"{schema.JOINT_NAMES[loaded.max()]} |")  # fmt: skip
+                      f"{named[0][0] if named else '-'} | {contact_cells(during)} | "
+                      f"{schema.JOINT_NAMES[nearest]} |")  # fmt: skip
+    for stem, share in moved.items():  # the contact watch's guard: nothing commanded
+        print(f"\n{stem}: the controller's model torque moved at most {share.max():.2%} of a "
+              "joint's rating over the log (the contact watch reads a push only while it stays "
+              "put).")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -153,3 +153,16 @@ for seed in 42 43 44 45 46; do
   $PY experiments/real_arms/sensitivity.py --runs $runs --seed $seed --suffix _ownmotion_rate0.99
   echo
 done > results/real_arms/sensitivity.md
+# The contact watch (2026-11-27, seventeenth session): a push on the arm while it holds a pose,
+# from the torque residual (robohealth_mj/runtime/contact.py). Its settings chosen on the twin
+# pushed, the program logs and the first pushed log, tested on the monitored logs and the second
+# (contact.md, about 5 minutes); then the cruise model at seed 42 recommissioned (the campaigns
+# above commission with the watch from a fresh start) and monitored on the pushed logs
+# (events_contact.md)
+$PY experiments/real_arms/contact.py > results/real_arms/contact.md
+CRUISE42=$(find outputs/real_arms/cruise/models -path '*stgnn_fixed/w32/seed42')
+$PY -m robohealth_mj.commission model="$CRUISE42/best.ckpt" arm=ur10e healthy_rate=0.99 \
+  "healthy=[$(ls outputs/real_arms/logs/jointwise_motion/*.csv | paste -sd,),outputs/real_arms/halves/ur-20_01_17-ptp_10_points_first_half.csv]" \
+  out="$CRUISE42/commissioned_ownmotion_rate0.99"
+$PY experiments/real_arms/events.py --run cruise --suffix _ownmotion_rate0.99 --observability motion \
+  > results/real_arms/events_contact.md

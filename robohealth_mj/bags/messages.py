@@ -64,6 +64,8 @@ def health_fields(d: Any, classes: list[str], joints: list[str]) -> tuple[int, s
     scores as text."""
     if d.alarm_class is not None:
         level, message = 2, f"ALARM {d.alarm_class} @ {d.alarm_joint} ({d.alarm})"
+    elif d.contact:
+        level, message = 2, f"CONTACT @ {d.contact_joint}"
     elif not d.valid:
         level, message = 1, f"invalid sample: {d.reason}"
     elif d.fault_present:
@@ -79,6 +81,7 @@ def health_fields(d: Any, classes: list[str], joints: list[str]) -> tuple[int, s
         "alarm": str(d.alarm),
         "alarm_class": d.alarm_class or "",
         "alarm_joint": d.alarm_joint or "",
+        "contact_joint": d.contact_joint or "",
         "valid": str(d.valid).lower(),
         "sample_index": "" if d.sample_index is None else str(d.sample_index),
         **{f"p.{c}": f"{d.class_probabilities.get(c, 0.0):.4f}" for c in classes},

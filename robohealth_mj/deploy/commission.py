@@ -6,7 +6,9 @@ is fitted on the new arm and on the model's own training arms (their healthy tic
 difference rides with the graph into the checkpoint and the exported model's input stage. The
 report says how many healthy minutes the baseline needed to settle. A harness model's coupling
 ``C`` is refitted to where the arm's sensors sit (placement self-calibration), and last the
-healthy operating point is matched (:mod:`robohealth_mj.deploy.operating_point`).
+healthy operating point is matched (:mod:`robohealth_mj.deploy.operating_point`). Where the
+model reads the torque residual, the contact watch's thresholds are fitted on the same healthy
+running (:mod:`robohealth_mj.runtime.contact`).
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.data import baseline
 from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings, single_arm
 from robohealth_mj.data.graphs import GraphSpec, harness_graph
+from robohealth_mj.data.relative import to_raw
+from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.deploy.export import export_checkpoint, file_fingerprint
 from robohealth_mj.deploy.operating_point import Reading, check_recipe, match_operating_point
 from robohealth_mj.deploy.recouple import recouple
@@ -34,6 +38,7 @@ from robohealth_mj.learn.checkpoint import (
     save_checkpoint,
 )
 from robohealth_mj.learn.trainer import CHECKPOINT
+from robohealth_mj.runtime.contact import commission_thresholds
 
 PLACEMENT = "placement.json"  # the placement self-calibration found, [6, M]
 MINUTES = (0.5, 1.0, 2.0, 3.0, 5.0, 7.5, 10.0, 15.0, 20.0)
@@ -76,6 +81,22 @@ def reads_residuals(graph: GraphSpec) -> bool:
     return bool(graph.channel_mask[: schema.N_JOINTS, columns].any())
 
 
+def contact_record(rec: Recording, arm: str, sensing: str, margin: float | None) -> dict:
+    """The contact watch's thresholds for this arm from its healthy running, or why there are
+    none (no margin asked, a profile without the torque residual, no pose held long enough)."""
+    needed = ("vel", "effort", "effort_residual")
+    if margin is None:
+        return {"skipped": "contact_margin=null"}
+    if not set(needed) <= set(load_profile(sensing).joint_channels):
+        return {"skipped": f"the sensing profile '{sensing}' lacks one of {', '.join(needed)}"}
+    raw = to_raw(rec.x, arm)
+    runs = [raw[rec.run == r] for r in range(len(rec.run_ids))]
+    thresholds, how = commission_thresholds([r for r in runs if len(r)], arm, margin)
+    if thresholds is None:
+        return {"skipped": how}
+    return {"threshold_nm": [round(float(v), 4) for v in thresholds], "rule": how}
+
+
 def arm_placement(graph: GraphSpec, placement: dict | None) -> np.ndarray:
     """Where this arm's harness sensors sit: ``placement`` (``coupling_seed`` and
     ``coupling_sensors``, ``coupling_file`` or ``coupling``, as ``graph=harness`` takes them),
@@ -105,13 +126,17 @@ def commission(
     operating_point: str = "per_class",
     arm: str | None = None,
     healthy_rate: float | None = None,
+    contact_margin: float | None = 2.0,
 ) -> dict[str, Any]:
     """Write ``out_dir/best.ckpt`` (and ``model.onnx`` for a network) commissioned on
     ``healthy``; the commissioning record (also in the checkpoint). A harness model with a
     coupling head also has its ``C`` refitted to the arm's ``placement``
     (:mod:`robohealth_mj.deploy.recouple`). ``arm``: the arm ``healthy`` comes from where it
-    names none (a controller log, a bag)."""
+    names none (a controller log, a bag). ``contact_margin``: the contact watch's thresholds over
+    the healthy running's largest quiet deviations (None: no watch)."""
     check_recipe(operating_point, healthy_rate)  # before minutes of work, not after
+    if contact_margin is not None and not contact_margin > 0:
+        raise InputError(f"contact_margin: must be positive (or null), got {contact_margin}")
     ckpt = load_checkpoint(ckpt_path)
     healthy_files = expand_paths(healthy)
     arm_name = single_arm(healthy_files, arm, "healthy")
@@ -146,6 +171,7 @@ def commission(
             f"the sensing profile '{trained.sensing}' reads no residual channel "
             f"({', '.join(baseline.RESIDUALS)})"
         )
+    record["contact"] = contact_record(arm, arm_name, trained.sensing, contact_margin)
     graph = replace(trained, baseline_shift=delta)
     out_dir = Path(out_dir)
     model = model_from_checkpoint(ckpt)

@@ -287,13 +287,16 @@ def export_checkpoint(
 
 
 def commissioning_metadata(ckpt: dict[str, Any]) -> dict[str, str]:
-    """What a commissioned model was commissioned on (nothing for one that was not)."""
+    """What a commissioned model was commissioned on (nothing for one that was not), and the
+    contact watch's thresholds where commissioning fitted them."""
     record = ckpt.get("commissioning")
     if not record:
         return {}
+    contact = (record.get("contact") or {}).get("threshold_nm")
     return {
         "commissioning_data_fingerprint": record["healthy_fingerprint"],
         "commissioning_healthy_minutes": str(record["healthy_minutes"]),
+        **({"contact_threshold_nm": json.dumps(contact)} if contact else {}),
     }
 
 

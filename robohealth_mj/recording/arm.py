@@ -22,6 +22,7 @@ from robohealth_mj.schema import FaultLabel
 from robohealth_mj.sim.control import TrackingController
 from robohealth_mj.sim.curriculum import Curriculum
 from robohealth_mj.sim.model import ArmIndex
+from robohealth_mj.sim.pushes import Push, applied_forces
 from robohealth_mj.sim.sensors import SensorPackage
 
 
@@ -60,6 +61,7 @@ class ArmSimulator:
         tick_hz: float = 20.0,
         chunk_s: float = 1.0,
         faults: FaultInjector | None = None,
+        pushes: list[Push] | None = None,
     ) -> None:
         self.model, self.curriculum = model, curriculum
         self.controller, self.sensors = controller, sensors
@@ -75,6 +77,7 @@ class ArmSimulator:
         self.tick = 0  # ticks completed
         self.nstate = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         self.faults = faults or healthy_injector(model, self.tick_s)
+        self.pushes = list(pushes or [])  # external forces on the links (sim/pushes.py)
         self._interval = None
         self._start_at_rest()
 
@@ -128,14 +131,18 @@ class ArmSimulator:
         step_times = (first + np.arange(steps)) * self.dt
         ctrl, ref_velocity, model_torque = self._controls(visit, step_times)
         forces = self.faults.torques(self._interval, step_times, ref_velocity, self.model.nv)
+        controls, spec = [ctrl, forces], _CONTROL_SPEC
+        if self.pushes:  # only then: the rollout's inputs grow by six per body
+            controls.append(applied_forces(self.model, self.data, self.pushes, step_times))
+            spec |= int(mujoco.mjtState.mjSTATE_XFRC_APPLIED)
         state0 = np.empty(self.nstate)
         mujoco.mj_getState(self.model, self.data, state0, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         state, sensordata = rollout.rollout(
             self.model,
             self.data,
             state0[None],
-            np.hstack([ctrl, forces])[None],
-            control_spec=_CONTROL_SPEC,
+            np.hstack(controls)[None],
+            control_spec=spec,
             initial_warmstart=self.data.qacc_warmstart[None],
         )
         state, sensordata = state[0], sensordata[0]

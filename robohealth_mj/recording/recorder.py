@@ -39,6 +39,7 @@ from robohealth_mj.schema import (
     FaultLabel,
 )
 from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
+from robohealth_mj.sim.pushes import read_pushes
 from robohealth_mj.sim.twin_file import read_twin_noise
 
 GRAPHS_FILE = "graphs.jsonl"
@@ -61,6 +62,8 @@ def default_run_id(cfg: DictConfig) -> str:
     for key in _OPTIONAL_SIM:
         if data.get("sim", {}).get(key, 0) is None:
             del data["sim"][key]
+    if not data["session"].get("pushes", 1):  # added later too: out of the id while empty
+        del data["session"]["pushes"]
     digest = hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:10]
     return recorded_run_id(arm_name(cfg), cfg.seed, digest)
 
@@ -189,6 +192,7 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
         tick_hz=cfg.session.tick_hz,
         chunk_s=cfg.session.chunk_s,
         faults=faults,
+        pushes=read_pushes(cfg.session.get("pushes") or [], model),
     )
     sim.arm = arm  # the drawn factors ({} for the nominal arm), for the manifest
     sim.ratings = description.ratings()

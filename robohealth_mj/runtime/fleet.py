@@ -9,7 +9,9 @@ windows (:mod:`robohealth_mj.runtime.evidence`; reset with the window on a gap),
 update in bulk on the accumulated probabilities. With ``observability="motion"`` a stream's
 window calls friction and backlash only on joints that moved in it
 (:mod:`robohealth_mj.data.observability`; the last sample index at which each joint moved is
-kept per stream). A bad row
+kept per stream). A model commissioned with contact thresholds also runs the contact watch
+on every valid row (:mod:`robohealth_mj.runtime.contact`: a push on an arm that holds a pose),
+warming rows included. A bad row
 never raises: it comes back flagged with its reason. Several rows from one stream in one tick
 (a burst) are taken in order, up to ``max_burst``; the rest are flagged and dropped.
 """
@@ -18,6 +20,7 @@ from __future__ import annotations
 
 import base64
 import gc
+import json
 import logging
 import time
 from collections.abc import Sequence
@@ -33,6 +36,7 @@ from robohealth_mj.common.numeric import joint_scores_from_logits, softmax
 from robohealth_mj.data.observability import MOVING_RAD_S, check_observability, hide_unobservable
 from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
+from robohealth_mj.runtime.contact import ContactBank, ContactPolicy
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
 from robohealth_mj.runtime.phases import NO_CLOCK, NoClock
@@ -66,6 +70,8 @@ class TickResult:
     alarm: np.ndarray  # [R] alarms.NONE/RAISED/HELD/CLEARED (decided rows)
     alarm_class: np.ndarray  # [R] alarmed class index, 0 when none
     alarm_joint: np.ndarray  # [R] alarmed joint index, -1 when none
+    contact: np.ndarray  # [R] the contact watch's call (valid rows; False when it is off)
+    contact_joint: np.ndarray  # [R] the joint nearest the contact, -1 when none
     reasons: dict[int, str] = field(default_factory=dict)  # row -> why flagged / undecided
     inference_ms: float = 0.0
 
@@ -82,6 +88,8 @@ def _empty(n: int, classes: int, joints: int) -> dict[str, np.ndarray]:
         "alarm": np.zeros(n, np.int8),
         "alarm_class": np.zeros(n, np.int64),
         "alarm_joint": np.full(n, -1, np.int64),
+        "contact": np.zeros(n, bool),
+        "contact_joint": np.full(n, -1, np.int64),
     }
 
 
@@ -131,8 +139,11 @@ class FleetRuntime:
         chunk: int = 256,
         providers: Sequence[str] | None = None,
         observability: str = "all",
+        contact: ContactPolicy | None = None,
     ) -> None:
         self.observability = check_observability(observability)
+        self.contact_policy = contact or ContactPolicy()
+        self.contact: ContactBank | None = None  # set by a model that carries thresholds
         self.max_streams, self.max_burst = max_streams, max_burst
         self.chunk = max(1, chunk)
         self.max_gap_s, self.idle_ticks = max_gap_s, idle_ticks
@@ -254,6 +265,10 @@ class FleetRuntime:
             )
             self.mode = "windowed"
         self.model_id = meta["model_id"]
+        if "contact_threshold_nm" in meta and self.contact_policy.enabled:
+            self.contact = ContactBank(
+                self.contact_policy, json.loads(meta["contact_threshold_nm"]), self.arm, capacity
+            )
 
     # streams
 
@@ -289,6 +304,8 @@ class FleetRuntime:
             self.engine.reset(np.array([slot]))
         self.alarms.reset(np.array([slot]))
         self.evidence.reset(np.array([slot]))
+        if self.contact is not None:
+            self.contact.reset(np.array([slot]))
         return slot
 
     def _grow(self, capacity: int) -> None:
@@ -296,6 +313,8 @@ class FleetRuntime:
             self.engine.ensure(capacity)
         self.alarms.ensure(capacity)
         self.evidence.ensure(capacity)
+        if self.contact is not None:
+            self.contact.ensure(capacity)
         n = capacity - self.capacity
         self.last_t = np.concatenate([self.last_t, np.full(n, -np.inf)])
         self.last_index = np.concatenate([self.last_index, np.full(n, -1, np.int64)])
@@ -399,10 +418,16 @@ class FleetRuntime:
             self.engine.reset(gs[gap])
             self.evidence.reset(gs[gap])
             self.last_moved[gs[gap]] = _NEVER
+            if self.contact is not None:
+                self.contact.reset(gs[gap])
         self.last_t[gs], self.last_index[gs] = gt, gi
         if self.observability == "motion":
             fast = np.abs(x[good][:, : schema.N_JOINTS, _VEL]) > MOVING_RAD_S  # [g, J]
             self.last_moved[gs] = np.where(fast, gi[:, None], self.last_moved[gs])
+        if self.contact is not None:  # every valid row, before its window is full too
+            out["contact"][rows[good]], out["contact_joint"][rows[good]] = self.contact.update(
+                gs, x[good]
+            )
         self._clock.mark("validate, bookkeeping")
         start = time.perf_counter()
         decide = final[good]
@@ -491,6 +516,7 @@ class FleetRuntime:
             "threads": self.threads,
             "joint_scores": self.joint_scores,
             "observability": self.observability,
+            "contact": None if self.contact is None else self.contact.threshold.tolist(),
             "problem": self.problem,
         }
 

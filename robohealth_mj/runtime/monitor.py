@@ -41,11 +41,12 @@ from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, GraphSample
 def describe(d: HealthDiagnosis) -> str:
     if not d.valid:
         return f"INVALID ({d.reason})"
+    contact = f"CONTACT @ {d.contact_joint}; " if d.contact else ""
     if d.fault_class is None:
-        return f"no decision ({d.reason})"
+        return f"{contact}no decision ({d.reason})"
     if not d.fault_present:
-        return f"healthy (p={d.confidence:.2f})"
-    return f"{d.fault_class} @ {d.localised_joint} (p={d.confidence:.2f})"
+        return f"{contact}healthy (p={d.confidence:.2f})"
+    return f"{contact}{d.fault_class} @ {d.localised_joint} (p={d.confidence:.2f})"
 
 
 def refuse_lacking_data(model: str, data_sensing: str, source: str) -> None:

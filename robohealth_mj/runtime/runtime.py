@@ -21,6 +21,7 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.runtime.alarms import STATE_NAMES, AlarmPolicy
+from robohealth_mj.runtime.contact import ContactPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import DECIDED, INVALID, FleetRuntime, TickResult
 from robohealth_mj.schema import GraphSample, SchemaError, validate_sample
@@ -47,6 +48,9 @@ class HealthDiagnosis:
     alarm: str = "none"  # none | raised | held | cleared (debounced, see runtime.alarms)
     alarm_class: str | None = None
     alarm_joint: str | None = None
+    # the contact watch (runtime.contact): an external force on an arm holding a pose
+    contact: bool = False
+    contact_joint: str | None = None  # the joint nearest it (the most distal joint it loads)
 
     def to_json(self) -> str:
         return json.dumps(asdict(self), sort_keys=True)
@@ -68,6 +72,8 @@ def diagnoses(fleet: FleetRuntime, result: TickResult) -> list[HealthDiagnosis]:
             model_id=fleet.model_id,
             reason=result.reasons.get(k),
         )
+        if result.contact[k]:
+            d.contact, d.contact_joint = True, fleet.joints[int(result.contact_joint[k])]
         if status == DECIDED:
             decide(
                 d, result.probs[k], result.joint_scores[k], int(result.alarm[k]),
@@ -118,10 +124,11 @@ class ModelRuntime:
         incremental: bool = True,
         evidence: EvidencePolicy | None = None,
         observability: str = "all",
+        contact: ContactPolicy | None = None,
     ) -> None:
         self.fleet = FleetRuntime(
             model_path, threads=threads, alarm=alarm, evidence=evidence, incremental=incremental,
-            observability=observability,
+            observability=observability, contact=contact,
         )  # fmt: skip
         self._queue: list[tuple[int, GraphSample]] = []
 

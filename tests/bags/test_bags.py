@@ -234,19 +234,23 @@ def test_a_diagnosis_message_carries_every_field_as_key_values(tmp_path):
     )  # fmt: skip
     invalid = HealthDiagnosis(stamp=12.55, stream_id="arm7", sample_index=None, valid=False,
                               model_id="m-1", reason="x: NaN")  # fmt: skip
+    pushed = HealthDiagnosis(stamp=12.6, stream_id="arm7", sample_index=252, valid=True,
+                             model_id="m-1", contact=True, contact_joint="wrist_2")  # fmt: skip
     with BagWriter(tmp_path / "kv") as writer:
         writer.write_diagnosis(alarmed, classes, joints)
         writer.write_diagnosis(invalid, classes, joints)
+        writer.write_diagnosis(pushed, classes, joints)
     store = typestore()
     with Reader(tmp_path / "kv") as reader:
         messages = [(stamp, store.deserialize_cdr(raw, conn.msgtype))
                     for conn, stamp, raw in reader.messages()]  # fmt: skip
-    assert [stamp for stamp, _ in messages] == [stamp_ns(12.5), stamp_ns(12.55)]
-    first, second = (m.status[0] for _, m in messages)
+    assert [stamp for stamp, _ in messages] == [stamp_ns(12.5), stamp_ns(12.55), stamp_ns(12.6)]
+    first, second, third = (m.status[0] for _, m in messages)
     assert (first.name, first.hardware_id) == ("health_diagnosis", "m-1")
     assert {kv.key: kv.value for kv in first.values} == {
         "fault_class": "jam", "joint": "elbow", "confidence": "0.9000", "alarm": "held",
-        "alarm_class": "jam", "alarm_joint": "elbow", "valid": "true", "sample_index": "250",
+        "alarm_class": "jam", "alarm_joint": "elbow", "contact_joint": "", "valid": "true",
+        "sample_index": "250",
         "p.none": "0.0100", "p.backlash": "0.0200", "p.friction": "0.0300", "p.jam": "0.9000",
         "p.struct_weaken": "0.0200", "p.sensor_drift": "0.0100", "p.sensor_noise": "0.0100",
         "score.shoulder_pan": "0.1000", "score.shoulder_lift": "0.2000", "score.elbow": "0.8000",
@@ -257,6 +261,8 @@ def test_a_diagnosis_message_carries_every_field_as_key_values(tmp_path):
     assert values["fault_class"] == values["joint"] == ""
     assert values["alarm_class"] == values["alarm_joint"] == "" and values["alarm"] == "none"
     assert values["p.jam"] == "0.0000" and values["score.elbow"] == "0.0000"
+    assert (third.level, third.message) == (2, "CONTACT @ wrist_2")  # a push is an error
+    assert {kv.key: kv.value for kv in third.values}["contact_joint"] == "wrist_2"
 
 
 @pytest.fixture(scope="module")

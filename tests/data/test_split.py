@@ -112,3 +112,13 @@ def test_friction_settings_left_unset_keep_the_run_id_of_a_config_without_them()
     assert default_run_id(cfg) == default_run_id(older)
     cfg.sim.friction_solref = [0.002, 1.0]  # set, it is part of what was simulated
     assert default_run_id(cfg) != default_run_id(older)
+
+
+def test_no_pushes_keep_the_run_id_of_a_config_without_them():
+    cfg = _record_config("ur5e").copy()
+    older = cfg.copy()  # a config from before session.pushes existed
+    with open_dict(older.session):
+        del older.session["pushes"]
+    assert default_run_id(cfg) == default_run_id(older)
+    cfg.session.pushes = [{"at_s": 1, "for_s": 1, "link": "forearm_link", "force_n": [0, 9, 0]}]
+    assert default_run_id(cfg) != default_run_id(older)

@@ -4,6 +4,7 @@ what the arm adds, a nominal arm's model stays as it was, and the commissioned O
 from __future__ import annotations
 
 import json
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +22,10 @@ from robohealth_mj.deploy.commission import commission
 from robohealth_mj.deploy.operating_point import check_recipe, per_class_offset
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
 from robohealth_mj.recording.recorder import record_session
+from robohealth_mj.runtime.contact import ContactPolicy
 from robohealth_mj.runtime.metadata import read_metadata
+from robohealth_mj.runtime.runtime import ModelRuntime
+from robohealth_mj.runtime.sources import replay_stream
 
 J = schema.N_JOINTS
 ELBOW, RESIDUAL = 2, schema.feature_index("effort_residual")
@@ -227,3 +231,39 @@ def test_a_model_that_reads_no_residual_gets_no_settling_table(tiny_corpus, heal
                         export=False)  # fmt: skip
     assert record["settling"] == [] and record["settled_minutes"] is None
     assert "'retrofit' reads no residual channel" in record["settling_skipped"]
+
+
+HOLD = ["session.progress=false", "faults=none", "curriculum.families=[hold]"]
+PUSH = "{at_s: 8, for_s: 1, link: forearm_link, force_n: [0, 40, 0], point_m: [-0.2, 0, 0.05]}"
+
+
+def test_commissioning_fits_the_contact_watch_and_the_monitor_calls_a_push_with_it(
+    stock_deployed, healthy, tmp_path
+):
+    """Healthy running that holds a pose gives the contact watch its thresholds, which ride in
+    the exported model; the monitor then calls a simulated push on the forearm at the elbow,
+    while it lasts, and nothing on healthy running. Running that never rests gives none."""
+    ckpt = stock_deployed["ckpt"]
+    reference = str(Path(stock_deployed["heldout"]).parents[1] / "train_*")
+    for name, extra in (("hold", []), ("pushed", [f"session.pushes=[{PUSH}]"])):
+        cfg = compose_config("record", [*HOLD, "seed=3", "session.duration_s=12", *extra])
+        record_session(cfg, tmp_path / name)
+    record = commission(ckpt, str(tmp_path / "hold"), tmp_path / "c", reference)
+    thresholds = record["contact"]["threshold_nm"]
+    assert len(thresholds) == J and min(thresholds) > 0
+    assert json.loads(read_metadata(record["onnx"])["contact_threshold_nm"]) == thresholds
+
+    def contacts(data: Path, **kwargs) -> list:
+        runtime = ModelRuntime(record["onnx"], **kwargs)
+        said = [runtime.process("arm", s) for _, s, _ in replay_stream(str(data / "graphs.jsonl"))]
+        return [d.contact_joint for d in said]
+
+    assert not any(contacts(tmp_path / "hold"))
+    called = contacts(tmp_path / "pushed", contact=ContactPolicy())
+    during = [j for j in called[160:181] if j]  # the push: ticks 160-180 (8 s for 1 s)
+    assert len(during) >= 15 and Counter(during).most_common(1)[0][0] == "elbow"
+    assert not any(called[:160]) and not any(called[183:])
+    off = contacts(tmp_path / "pushed", contact=ContactPolicy(enabled=False))
+    assert not any(off)
+    sweeps = commission(ckpt, str(healthy["nominal"]), tmp_path / "s", reference, export=False)
+    assert "no quiet of 25 ticks" in sweeps["contact"]["skipped"]

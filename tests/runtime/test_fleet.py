@@ -389,7 +389,7 @@ def test_sharded_steps_decide_as_one_shard_does(deployed):
     assert (r.status == DECIDED).all()
     assert two.describe() == {
         "model_id": one.model_id, "arm": "ur5e", "window": 8, "mode": "incremental", "threads": 1,
-        "joint_scores": "softmax", "observability": "all", "problem": None,
+        "joint_scores": "softmax", "observability": "all", "contact": None, "problem": None,
     }  # fmt: skip
     assert one.model_id.startswith("stgnn_fixed-structural-w8-")
 
@@ -418,6 +418,7 @@ def test_monitor_refuses_nonsense_alarm_and_evidence_settings(deployed, capsys):
         ("alarm.min_confidence=2", "alarm: alarm min_confidence must lie in [0, 1], got 2"),
         ("evidence.clip=-1", "evidence: evidence clip and floor must be > 0, got -1"),
         ("evidence.half_life=3", "evidence: EvidencePolicy.__init__() got an unexpected"),
+        ("contact.confirm=0", "contact: contact confirm must be at least 1 tick, got 0"),
     ):
         with pytest.raises(SystemExit) as info:
             monitor_main([f"model={deployed['structural_onnx']}", bad])
