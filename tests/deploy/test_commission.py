@@ -213,6 +213,12 @@ def test_an_unknown_operating_point_recipe_is_one_line(stock_deployed, healthy, 
     err = capsys.readouterr().err.strip()
     assert done.value.code == 2 and "\n" not in err
     assert "operating_point must be one of ('per_class', 'healthy'), got 'median'" in err
+    with pytest.raises(SystemExit) as done:
+        commission_main([f"model={stock_deployed['ckpt']}", f"healthy={healthy['nominal']}",
+                         "contact_margin=0", "export=false"])  # fmt: skip
+    err = capsys.readouterr().err.strip()
+    assert done.value.code == 2 and "\n" not in err
+    assert "contact_margin: must be positive (or null), got 0" in err
 
 
 @pytest.mark.slow
