@@ -135,7 +135,8 @@ def monitor_stream(
         f"{_num(result['false_alarm_rate'])} of settled healthy ticks "
         f"({_num(result['false_alarms_per_hour'])}/h), latency to class "
         f"{_num(alarms['class_latency_s_median'])} s, to joint "
-        f"{_num(alarms['joint_latency_s_median'])} s (medians) -> {out}"
+        f"{_num(alarms['joint_latency_s_median'])} s (medians); contact calls "
+        f"{result['contact_calls']} -> {out}"
     )
     return result
 

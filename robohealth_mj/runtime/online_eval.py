@@ -24,6 +24,10 @@ faulted joint ever moved and whether it carried load: friction on a joint that n
 structural weakening of a joint that carries no load change nothing any channel sees, so those
 episodes are counted apart (``physically_hidden``) and the rest (``observable``) are the ceiling
 a detector can reach.
+
+The contact watch's calls (:mod:`robohealth_mj.runtime.contact`) are counted apart: its ticks
+and its calls (a call: a run of contact ticks), over every tick. No fault label marks a push, so
+on running without one every call is a false one.
 """
 
 from __future__ import annotations
@@ -103,9 +107,12 @@ class OnlineEvaluator:
     settled: int = 0
     settled_alarm_ticks: int = 0
     false_alarms: int = 0
+    contact_ticks: int = 0
+    contact_calls: int = 0
     episodes: list[_Episode] = field(default_factory=list)
     _tick: int = 0
     _last_faulted: int | None = None
+    _in_contact: bool = False
 
     def update(
         self,
@@ -120,6 +127,9 @@ class OnlineEvaluator:
         self._tick += 1
         current = self.episodes[-1] if self.episodes else None
         alarm_up = d.alarm_class is not None
+        self.contact_ticks += d.contact
+        self.contact_calls += d.contact and not self._in_contact
+        self._in_contact = d.contact
         if truth.active:
             key = (truth.fault_class, truth.joint, truth.severity)
             if (
@@ -194,6 +204,9 @@ class OnlineEvaluator:
             "false_alarm_rate": rate(self.settled_alarm_ticks, self.settled),
             "false_alarms": self.false_alarms,
             "false_alarms_per_hour": rate(self.false_alarms, settled_hours),
+            "contact_ticks": self.contact_ticks,
+            "contact_calls": self.contact_calls,
+            "contact_calls_per_hour": rate(self.contact_calls, self._tick * self.tick_s / 3600),
             "episodes": len(self.episodes),
             "alarms": self._summary(self.episodes),
             "alarms_by_class": {k: self._summary(v) for k, v in sorted(by_class.items())},

@@ -54,6 +54,9 @@ def online_markdown(result: dict[str, Any]) -> str:
         f"{result['settled_healthy_ticks']} settled healthy ticks, "
         f"{result['false_alarms']} raised ({_f(result['false_alarms_per_hour'])} per healthy "
         f"hour); per-tick decisions alone: {_f(result['false_positive_rate'], 4)} of healthy ticks",
+        f"- contact watch: {result.get('contact_calls', 0)} calls "
+        f"({result.get('contact_ticks', 0)} ticks, "
+        f"{_f(result.get('contact_calls_per_hour'))} per hour)",
         f"- latency to the right class: median {_f(a['class_latency_s_median'])} s, p90 "
         f"{_f(a['class_latency_s_p90'])} s; to the right joint: median "
         f"{_f(a['joint_latency_s_median'])} s, p90 {_f(a['joint_latency_s_p90'])} s",

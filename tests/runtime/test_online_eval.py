@@ -103,3 +103,17 @@ def test_friction_on_a_still_joint_and_weakening_without_load_are_counted_apart(
 
 def test_rated_torques_come_from_the_arm_s_parameter_file():
     assert rated_torque_nm().tolist() == [150.0, 150.0, 150.0, 28.0, 28.0, 28.0]
+
+
+def test_contact_calls_are_counted_apart_from_the_alarms():
+    evaluator = OnlineEvaluator(settle_ticks=0)
+    pattern = [False, True, True, False, True, False, False]  # two calls, three ticks
+    for on in pattern * 10:
+        d = _diag()
+        d.contact, d.contact_joint = on, "elbow" if on else None
+        evaluator.update(FaultLabel(), d)
+    result = evaluator.result()
+    assert (result["contact_calls"], result["contact_ticks"]) == (20, 30)
+    assert result["contact_calls_per_hour"] == pytest.approx(20 / (70 * 0.05 / 3600))
+    assert result["false_alarms"] == 0  # a contact is no fault alarm
+    assert "- contact watch: 20 calls (30 ticks" in online_markdown(result)
