@@ -140,7 +140,7 @@ def main() -> None:
                   + "/commissioning.json"))  # fmt: skip
     commissioning = [raw(Path(p)) for p in json.loads(record.read_text())["healthy"]]
     logs = {kind: [raw(find_log(p.stem)) for p in sorted((verdicts / kind).glob("*.json"))]
-            for kind in ("program", "healthy", "push")}  # fmt: skip
+            for kind in ("program", "healthy", "push", "load")}  # fmt: skip
     hours = {k: sum(len(x) for x in v) / TICK_HZ / 3600 for k, v in logs.items()}
     unpushed, _ = held_pose(None)
     held = [held_pose(link) for link in SIM_PUSHES]
@@ -183,13 +183,18 @@ def main() -> None:
                  f"{sim[0]}/{len(held)}, {sim[1]}/{len(held)}, {sim[2]}",
                  "{} ({})".format(*healthy["program"]), push_text(pushed[0]),
                  "{} ({})".format(*healthy["healthy"]), push_text(pushed[1])]  # fmt: skip
-        rows.append((rule, cells))
+        rows.append((rule, cells, policy, threshold))
         print("| " + " | ".join(cells) + " |", flush=True)
-    rule, best = max(rows, key=lambda row: row[0])
+    _, best, policy, threshold = max(rows, key=lambda row: row[0])
     print(
         f"\nSelected by the rule: margin {best[0]}, confirm {best[1]}, model-torque guard "
         f"{best[2]}, still below {best[3]} rad/s, pushes left out of the level {best[4]}."
     )
+    calls = [watch(x, policy, threshold)[0] for x in logs["load"]]
+    print(f"\nThe selected setting on the {len(calls)} runs with an added load (healthy, a "
+          f"payload the controller was not told of; {hours['load'] * 60:.1f} min, used by no "
+          f"choice): {sum(int(c.sum()) for c in calls)} contact ticks in "
+          f"{sum(episodes(c) for c in calls)} calls.")  # fmt: skip
 
 
 def push_text(cells: tuple[int, int, list]) -> str:
