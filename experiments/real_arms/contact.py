@@ -17,9 +17,10 @@ the wrists, across the joint's axis); the watch is commissioned on the same hold
 Selection reads the simulated pushes, the program logs (healthy, judged by no run) and the first
 pushed log; the monitored healthy logs and the second pushed log are the test. The rule, in
 order: no call after a simulated push has ended (an echo: the truth is known there); none on the
-program logs; the most pushes of the first log called; the most of its joints named right; the
-most confirming ticks (a contact call is an alarm, and 5.6 min cannot show one an hour); the
-largest share of its pushes' ticks called.
+program logs; the most pushes called, simulated and on the first log together; the most joints
+named right, likewise; the most confirming ticks (a contact call is an alarm, and 5.6 min cannot
+show one an hour); the largest share of the first log's push ticks called. Last, the selected
+setting on the runs with an added load.
 """  # noqa: E501
 
 from __future__ import annotations

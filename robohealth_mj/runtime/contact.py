@@ -126,8 +126,9 @@ class ContactBank:
         flat = s[:, None] * p.level_ticks + rows  # one gather from the flattened ring
         past = self.ring.reshape(-1, J)[flat]  # [W, A, J]
         before = ages[None, :] >= length[watched][:, None]  # before the quiet began
-        skipped = self.skip.reshape(-1)[flat] & p.exclude_contact  # left out, unless that
-        left_out = before | (skipped & ~(before | skipped).all(axis=1, keepdims=True))  # is all
+        # with exclude_contact, ticks over a threshold are left out, unless that leaves none
+        skipped = self.skip.reshape(-1)[flat] & p.exclude_contact
+        left_out = before | (skipped & ~(before | skipped).all(axis=1, keepdims=True))
         past[left_out] = np.nan
         off[watched] = np.abs(residual[watched] - _median(past).astype(np.float64))
         return off
