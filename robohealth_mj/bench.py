@@ -10,6 +10,7 @@
     python -m robohealth_mj.bench streams --profile 1000 2000 [--shards 1]
     python -m robohealth_mj.bench soak [--model M] [--streams 1000] [--seconds 60]
     python -m robohealth_mj.bench ros2 --model M [--arms 10 25 50] [--seconds 20] [--monitors 1 2]
+    python -m robohealth_mj.bench contact [--streams 100 1000 4000]
 
 ``sim`` measures, in one run, the raw ``mj_step`` rate of the scene and the recorder's throughput
 (physics + control + sensor synthesis + JSONL writing), and reports their ratio. ``train
@@ -18,7 +19,8 @@ and reports the time to its best checkpoint, data loading included. ``streams`` 
 recordings on many interleaved 20 Hz streams through the fleet runtime: the largest stream count
 whose per-tick p99 fits the 50 ms tick (search), then a paced run at ``--streams`` with its CPU
 share, and the windowed path beside the incremental one. ``soak`` runs a fleet under bad input
-(see ``robohealth_mj/benchmarks/soak.py``) and checks every flagged row and the memory.
+(see ``robohealth_mj/benchmarks/soak.py``) and checks every flagged row and the memory. ``contact``
+times the contact watch's update over streams that all hold a pose (its worst case).
 """
 
 from __future__ import annotations
@@ -66,6 +68,8 @@ def main(argv: list[str] | None = None) -> None:
     streams = sub.add_parser("streams", help="fleet load test: sustained 20 Hz streams")
     soak = sub.add_parser("soak", help="fleet under bad input: flags, tick budget, memory")
     ros2 = sub.add_parser("ros2", help="arms per monitor over DDS on loopback, end-to-end latency")
+    contact = sub.add_parser("contact", help="the contact watch's cost per fleet tick")
+    contact.add_argument("--streams", type=int, nargs="+", default=[100, 1000, 4000])
     ros2.add_argument("--model", required=True, help="an exported model.onnx")
     ros2.add_argument("--data", default="outputs/corpus/quick/heldout_seed900")
     ros2.add_argument("--arms", type=int, nargs="+", default=[10, 25, 50])
@@ -120,7 +124,11 @@ def main(argv: list[str] | None = None) -> None:
         help="alternated rounds of the with/without-memory comparison (0: skip it)",
     )
     args = parser.parse_args(argv)
-    if args.what == "ros2":
+    if args.what == "contact":
+        from robohealth_mj.benchmarks.contact import bench_contact
+
+        bench_contact(args.streams)
+    elif args.what == "ros2":
         from robohealth_mj.benchmarks.ros2 import bench_ros2
 
         bench_ros2(args.model, args.data, args.arms, args.seconds, args.layouts, args.monitors,

@@ -27,3 +27,5 @@ $PY -m robohealth_mj.bench streams > results/fleet/bench_streams.txt
 $PY -m robohealth_mj.bench soak > results/fleet/bench_soak.txt
 $PY -m robohealth_mj.bench infer --model $M --data outputs/corpus/standard/heldout_seed900 \
   > results/fleet/bench_infer_headline.txt
+# the contact watch's cost per tick, every stream holding a pose (2026-11-27, seventeenth session)
+$PY -m robohealth_mj.bench contact > results/fleet/bench_contact.txt

@@ -134,3 +134,12 @@ def test_contact_policy_and_pushes_refuse_nonsense_in_one_line():
             InputError, match=r"session\.pushes\[0\]: .*" + said.replace("[", r"\[")
         ):
             read_pushes([entry], model)
+
+
+def test_bench_contact_times_a_resting_fleet_per_stream_count(capsys):
+    from robohealth_mj.bench import main as bench_main
+
+    bench_main(["contact", "--streams", "3", "20"])
+    rows = [line for line in capsys.readouterr().out.splitlines() if line[2:3].isdigit()]
+    assert [row.split(" | ")[0] for row in rows] == ["| 3", "| 20"]
+    assert all(float(row.split(" | ")[1]) > 0 for row in rows)
