@@ -62,7 +62,7 @@ def default_run_id(cfg: DictConfig) -> str:
     for key in _OPTIONAL_SIM:
         if data.get("sim", {}).get(key, 0) is None:
             del data["sim"][key]
-    if not data["session"].get("pushes", 1):  # added later too: out of the id while empty
+    if data["session"].get("pushes") == []:  # added later too: out of the id while empty
         del data["session"]["pushes"]
     digest = hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:10]
     return recorded_run_id(arm_name(cfg), cfg.seed, digest)
