@@ -32,6 +32,15 @@ def _paths(value) -> list[str]:
     )
 
 
+def _cutoff(value) -> float | None:
+    """``cutoff_hz``: a frequency in Hz, or ``auto`` (None: chosen on the fit logs)."""
+    if value == "auto":
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        raise InputError(f"cutoff_hz: a frequency in Hz > 0 or auto, got {value!r}")
+    return float(value)
+
+
 def main(argv: list[str] | None = None) -> None:
     args = sys.argv[1:] if argv is None else argv
     cfg = load_cli_config("identify", args, "robohealth_mj.identify")
@@ -42,10 +51,16 @@ def main(argv: list[str] | None = None) -> None:
         if not fit:
             raise InputError("usage: python -m robohealth_mj.identify arm=ARM fit=[LOG,...] "
                              "validate=[LOG,...] out=DIR")  # fmt: skip
-        result = run_identification(str(cfg.arm), fit, validate, cfg.map, Path(cfg.out))
+        result = run_identification(str(cfg.arm), fit, validate, cfg.map, Path(cfg.out),
+                                    _cutoff(cfg.get("cutoff_hz", "auto")))  # fmt: skip
     drives = result["twin"]["drive_overrides"]
     print(f"fitted on {result['twin']['fit']['seconds']:g} s of {len(fit)} log(s) -> "
           f"{result['twin_file']}")  # fmt: skip
+    fitted = result["twin"]["fit"]
+    tried = fitted.get("held_out_nrmse_by_cutoff_hz")
+    how = ("given" if tried is None else "chosen on the fit logs, mean NRMSE on one left out: "
+           + ", ".join(f"{c:g} Hz {100 * v:.2f} %" for c, v in tried.items()))  # fmt: skip
+    print(f"  velocity low-pass {fitted['cutoff_hz']:g} Hz ({how})")
     k_t = result["twin"]["torque_constant_nm_per_a"]
     for j, joint in enumerate(JOINT_NAMES):
         d = drives[joint]

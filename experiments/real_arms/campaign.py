@@ -31,9 +31,10 @@ same commissioned models). Writes under
 ``outputs/real_arms/``: ``twin/`` (twin.yaml, fidelity.md), the corpora
 ``outputs/corpus/real_ur10e_<curriculum>``, and per run (``--name``, default the curriculum) the
 models ``<run>/models/`` and per model and log the monitor's verdict (``<run>/verdicts/``). Every
-step skips what is done. ``--swap VARIANT`` prints where the real arm's healthy running looks
-faulty to a commissioned network, and why: each monitored log's motion is replayed on the healthy
-twin (tick for tick the same motion), and the network reads the real ticks, the simulated ticks,
+step skips what is done; a recording made on another twin than the one named stops the run.
+``--swap VARIANT`` prints where the real arm's healthy running looks faulty to a commissioned
+network, and why: each monitored log's motion is replayed on the healthy twin (tick for tick the
+same motion), and the network reads the real ticks, the simulated ticks,
 and the real ticks with one channel (or one joint's torque residual) taken from the simulation.
 A swap that brings the real share of ticks called faulty to the simulated one names where twin and
 arm differ; a simulated share as high as the real one says the model calls this motion faulty in
@@ -54,8 +55,10 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_text
+from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.runtime.runtime import ModelRuntime
 from robohealth_mj.runtime.sources import replay_stream
+from robohealth_mj.sim.twin_file import mark_recorded, recorded_on
 
 ROOT = Path("outputs/real_arms")
 LOGS = ROOT / "logs"
@@ -220,9 +223,10 @@ def record_corpus(corpus_name: str, twin: Path, tag: str, stiction: bool = False
     config, extra = CORPORA[corpus_name]
     overrides = ["arm=ur10e", f"sim.twin={twin}", f"sim.mount_height_m={MOUNT_M}", *extra]
     overrides += STICTION if stiction else []
-    if not (corpus / "corpus.json").is_file():
+    if not recorded_on(corpus, corpus / "corpus.json", twin):
         run("robohealth_mj.corpus", f"corpus={config}", f"out_dir={corpus}",
             f"record_overrides={json.dumps(overrides)}", "progress=false")  # fmt: skip
+        mark_recorded(corpus, twin)
     return corpus
 
 
@@ -233,7 +237,7 @@ LEAD_S = 1.5  # the replay's first move (from rest to the log's first pose) befo
 def simulated(log: Path, twin: Path, out: Path) -> Path:
     """The log's motion replayed on the healthy twin (recorded once)."""
     graphs = out / "graphs.jsonl"
-    if not graphs.is_file():
+    if not recorded_on(out, graphs, twin):
         seconds = float(np.loadtxt(log, delimiter=",", usecols=0, ndmin=1)[[0, -1]] @ [-1, 1])
         subprocess.run([sys.executable, "-m", "robohealth_mj.record", "arm=ur10e",
                         f"sim.twin={twin}", f"sim.mount_height_m={MOUNT_M}", "curriculum=replay",
@@ -241,6 +245,7 @@ def simulated(log: Path, twin: Path, out: Path) -> Path:
                         "faults=none", f"session.duration_s={seconds + LEAD_S + 0.5:.2f}",
                         "seed=1", f"session.out_dir={out}", "session.progress=false"],
                        check=True, stdout=subprocess.DEVNULL)  # fmt: skip
+        mark_recorded(out, twin)
     return graphs
 
 
@@ -419,4 +424,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with one_line_errors("campaign"):
+        main()

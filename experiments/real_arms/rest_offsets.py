@@ -26,7 +26,9 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.runtime.sources import replay_stream
+from robohealth_mj.sim.twin_file import mark_recorded, recorded_on
 
 ROOT = Path("outputs/real_arms")
 HOLDS = sorted((ROOT / "logs" / "validation_data").glob("*-p[0-9]*.csv"))
@@ -63,13 +65,14 @@ def simulated(name: str, overrides: list[str]) -> Path:
     """The healthy hold session on the twin with ``overrides`` (recorded once)."""
     out = ROOT / "rest" / name
     graphs = out / "graphs.jsonl"
-    if not graphs.is_file():
+    if not recorded_on(out, graphs, TWIN):
         subprocess.run([sys.executable, "-m", "robohealth_mj.record", "arm=ur10e",
                         f"sim.twin={TWIN}", f"sim.mount_height_m={MOUNT_M}",
                         "curriculum.families=[hold]", "faults=none",
                         f"session.duration_s={SIM_SECONDS}", "seed=3", f"session.out_dir={out}",
                         "session.progress=false", *overrides],
                        check=True, stdout=subprocess.DEVNULL)  # fmt: skip
+        mark_recorded(out, TWIN)
     return graphs
 
 
@@ -97,4 +100,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with one_line_errors("rest_offsets"):
+        main()

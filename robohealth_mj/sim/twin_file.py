@@ -9,6 +9,8 @@ keeps the sensor package's), the logs it was fitted on and the fit's residuals.
 
 from __future__ import annotations
 
+import hashlib
+import json
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +21,7 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
 
 PARAMETERS = ("armature", "damping", "frictionloss")  # what identification fits per joint
+TWIN_MARK = "twin_digest.txt"  # beside a recording kept for reuse: the twin it was recorded on
 
 
 def write_twin(path: Path, content: dict) -> None:
@@ -71,3 +74,33 @@ def read_twin(path: Path | str, arm: str) -> dict[str, dict[str, float]]:
                                  f"got {value!r}")  # fmt: skip
             out[joint][name] = float(value)
     return out
+
+
+def twin_digest(path: Path | str) -> str:
+    """Twelve hex digits of what twin file ``path`` sets in the physics (drives and noise)."""
+    path = Path(path)
+    try:
+        content = yaml.safe_load(path.read_text())
+    except (OSError, yaml.YAMLError):
+        raise InputError(f"sim.twin: {path}: not a readable twin file") from None
+    physics = {k: (content or {}).get(k) for k in ("drive_overrides", "effort_noise_nm")}
+    return hashlib.sha256(json.dumps(physics, sort_keys=True).encode()).hexdigest()[:12]
+
+
+def recorded_on(out: Path, done: Path, twin: Path | str) -> bool:
+    """Whether folder ``out`` already holds a recording (its file ``done``) made on ``twin``, for
+    the research scripts that record once and reuse. A recording marked with another twin (one
+    identified again: other logs, another estimator) is refused in one line rather than reused;
+    an unmarked one (made before recordings were marked) is taken as it is."""
+    if not done.is_file():
+        return False
+    mark = out / TWIN_MARK
+    if mark.is_file() and mark.read_text().strip() != twin_digest(twin):
+        raise InputError(f"{out}: recorded on another twin than {twin}; move it aside to record "
+                         "on this one")  # fmt: skip
+    return True
+
+
+def mark_recorded(out: Path, twin: Path | str) -> None:
+    """Marks the recording in ``out`` as made on ``twin`` (see :func:`recorded_on`)."""
+    atomic_write_text(out / TWIN_MARK, twin_digest(twin) + "\n")

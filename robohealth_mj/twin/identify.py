@@ -10,8 +10,11 @@ and the log measures it twice: the controller's own model torque (``target_momen
 friction) and the motor current, ``i = tau / k_t``. So, per joint, by non-negative least squares:
 the rotor inertia from the model torque (where the log has one), then ``i`` on ``[rigid +
 armature * qdd, qd, sign(qd)]``, whose coefficients are ``1/k_t``, ``damping/k_t`` and
-``frictionloss/k_t`` (with no model torque in the log the rotor inertia joins that fit). The
-velocity is low-passed without phase lag and differentiated for the acceleration.
+``frictionloss/k_t`` (with no model torque in the log the rotor inertia joins that fit).
+
+The acceleration is the logged velocity's derivative after a zero-phase low-pass, whose cutoff
+trades noise against the fast part of the motion. By default it is chosen per arm by
+leave-one-log-out on the fit logs (:func:`choose_cutoff`), never on the logs it is validated on.
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 from scipy.optimize import nnls
-from scipy.signal import butter, filtfilt
+from scipy.signal import butter, sosfiltfilt
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
@@ -32,8 +35,10 @@ from robohealth_mj.sim.twin_file import PARAMETERS
 from robohealth_mj.twin.joint_log import JointLog
 
 SIGN_VELOCITY = 0.02  # rad/s: sign(qd) as tanh(qd / this), so friction is smooth through rest
-CUTOFF_HZ = 10.0  # the velocity's low-pass before differentiation (zero phase)
+CUTOFF_GRID_HZ = (3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0)  # the low-passes choose_cutoff tries
+UNIFORM_HZ = 500.0  # the grid the velocity is filtered on: the e-Series controller's cycle
 STILL_RAD_S = 1e-3  # every joint slower than this: the arm holds still
+MOVING_RAD_S = 1e-3  # a joint whose velocity spans less in the fit logs is not identified
 STILL_S = 1.0  # the shortest hold the measurement noise is read from
 TICK_HZ = 20.0  # the recordings' tick rate: the noise is what one tick reads
 
@@ -48,12 +53,24 @@ class Motion:
     sign: np.ndarray  # tanh(qd / SIGN_VELOCITY)
 
 
-def motion(log: JointLog) -> Motion:
-    rate = log.rate_hz
-    b, a = butter(2, min(CUTOFF_HZ, 0.4 * rate) / (0.5 * rate))
-    qd = filtfilt(b, a, log.qd, axis=0) if len(log.t) > 15 else log.qd
-    qdd = np.gradient(qd, log.t, axis=0)
-    return Motion(log.q, qd, qdd, np.tanh(qd / SIGN_VELOCITY))
+def motion(log: JointLog, cutoff_hz: float) -> Motion:
+    """The log's trajectory with its velocity low-passed at ``cutoff_hz`` (at most 0.4 x the
+    log's rate) and differentiated. A logger's rows come unevenly (on the public UR10e logs a
+    third of the steps are 12 ms, not 10), and a filter that takes them as evenly spaced bends the
+    acceleration; so the velocity is interpolated onto a uniform grid, filtered and
+    differentiated there, and read back at the rows."""
+    cutoff = min(float(cutoff_hz), 0.4 * log.rate_hz)
+    grid = np.arange(log.t[0], log.t[-1] + 0.5 / UNIFORM_HZ, 1.0 / UNIFORM_HZ)
+    qd = np.stack([np.interp(grid, log.t, log.qd[:, j]) for j in range(log.qd.shape[1])], axis=1)
+    if len(grid) > 15:
+        qd = sosfiltfilt(butter(2, cutoff, fs=UNIFORM_HZ, output="sos"), qd, axis=0)
+    qdd = np.gradient(qd, grid, axis=0)
+
+    def at_rows(x: np.ndarray) -> np.ndarray:
+        return np.stack([np.interp(log.t, grid, x[:, j]) for j in range(x.shape[1])], axis=1)
+
+    qd_rows = at_rows(qd)
+    return Motion(log.q, qd_rows, at_rows(qdd), np.tanh(qd_rows / SIGN_VELOCITY))
 
 
 def rigid_torques(arm: str, m: Motion, payload_kg: float = 0.0) -> np.ndarray:
@@ -120,8 +137,10 @@ class Identified:
     rows: int
     seconds: float
     used_model_torque: bool
+    cutoff_hz: float  # the velocity's low-pass the fit used
     notes: list[str] = field(default_factory=list)
     effort_noise: np.ndarray | None = None  # N*m per tick, per joint; None: no hold to read it
+    cutoff_scores: dict[float, float] | None = None  # choose_cutoff's table; None: cutoff given
 
 
 def effort_noise(logs: Sequence[JointLog], k_t: np.ndarray) -> np.ndarray | None:
@@ -142,23 +161,37 @@ def effort_noise(logs: Sequence[JointLog], k_t: np.ndarray) -> np.ndarray | None
     return np.concatenate(steps).std(axis=0) / np.sqrt(2.0)
 
 
-def identify(arm: str, logs: Sequence[JointLog]) -> Identified:
-    """Each joint's rotor inertia, viscous and Coulomb friction and torque constant, fitted on
-    ``logs`` (healthy running, no payload) pooled."""
-    if not logs:
-        raise InputError("identify: no log to fit on")
-    motions = [motion(log) for log in logs]
-    rigid = np.concatenate([rigid_torques(arm, m) for m in motions])
-    qdd = np.concatenate([m.qdd for m in motions])
-    qd = np.concatenate([m.qd for m in motions])
-    sign = np.concatenate([m.sign for m in motions])
-    current = np.concatenate([log.current for log in logs])
-    with_model = all(log.model_torque is not None for log in logs)
-    model_torque = np.concatenate([log.model_torque for log in logs]) if with_model else None
+@dataclass
+class _Prepared:
+    """One log as the fit reads it: the log, its motion and the links' torque along it."""
+
+    log: JointLog
+    motion: Motion
+    rigid: np.ndarray
+
+
+def _prepare(arm: str, logs: Sequence[JointLog], cutoff_hz: float) -> list[_Prepared]:
+    out = []
+    for log in logs:
+        m = motion(log, cutoff_hz)
+        out.append(_Prepared(log, m, rigid_torques(arm, m)))
+    return out
+
+
+def _fit(prepared: Sequence[_Prepared]) -> Drives:
+    """Per joint, by non-negative least squares on the pooled rows (see the module's
+    docstring): rotor inertia, viscous and Coulomb friction and torque constant."""
+    rigid = np.concatenate([p.rigid for p in prepared])
+    qdd = np.concatenate([p.motion.qdd for p in prepared])
+    qd = np.concatenate([p.motion.qd for p in prepared])
+    sign = np.concatenate([p.motion.sign for p in prepared])
+    current = np.concatenate([p.log.current for p in prepared])
+    with_model = all(p.log.model_torque is not None for p in prepared)
+    if with_model:
+        model_torque = np.concatenate([p.log.model_torque for p in prepared])
     armature, damping, friction, k_t = (np.zeros(len(JOINT_NAMES)) for _ in range(4))
-    notes = []
     for j, joint in enumerate(JOINT_NAMES):
-        if np.ptp(qd[:, j]) < 1e-3:
+        if np.ptp(qd[:, j]) < MOVING_RAD_S:
             raise InputError(f"identify: joint {joint} does not move in the fit logs")
         if with_model:
             armature[j] = nnls(qdd[:, [j]], model_torque[:, j] - rigid[:, j])[0][0]
@@ -174,15 +207,71 @@ def identify(arm: str, logs: Sequence[JointLog]) -> Identified:
             armature[j] = coef[1] * k_t[j]
             coef = np.delete(coef, 1)
         damping[j], friction[j] = coef[1] * k_t[j], coef[2] * k_t[j]
-    if not with_model:
-        notes.append("no model torque in the logs: rotor inertia fitted on the current")
-    noise = effort_noise(logs, k_t)
+    return Drives(armature, damping, friction, k_t)
+
+
+def _held_out_error(p: _Prepared, drives: Drives) -> float:
+    """Mean NRMSE over the joints on a log the fit did not see: the model torque against the
+    target moment where the log has one, else the whole torque against current x k_t."""
+    if p.log.model_torque is not None:
+        return float(nrmse(drives.model_torque(p.rigid, p.motion), p.log.model_torque).mean())
+    measured = p.log.current * drives.torque_constant
+    return float(nrmse(drives.torque(p.rigid, p.motion), measured).mean())
+
+
+def _halves(log: JointLog) -> list[JointLog]:
+    mid = len(log.t) // 2
+    return [JointLog(f"{log.source}[{a}:{b}]", log.t[a:b], log.q[a:b], log.qd[a:b],
+                     log.current[a:b], None if log.model_torque is None else log.model_torque[a:b])
+            for a, b in ((0, mid), (mid, len(log.t)))]  # fmt: skip
+
+
+def choose_cutoff(arm: str, logs: Sequence[JointLog]) -> tuple[float, dict[float, float]]:
+    """The velocity low-pass (of CUTOFF_GRID_HZ) whose fit best predicts a fit log it left out:
+    each log in turn is held out (a single log: its two halves), the rest fitted, and the
+    held-out error averaged (a fold whose other logs leave a joint still is not scored).
+    Returns the cutoff and the mean error per cutoff tried."""
+    folds = list(logs) if len(logs) >= 2 else _halves(logs[0])
+    highest = 0.4 * min(log.rate_hz for log in folds)
+    scores = {}
+    for cutoff in (c for c in CUTOFF_GRID_HZ if c <= highest):
+        prepared = _prepare(arm, folds, cutoff)
+        errors = []
+        for k, held_out in enumerate(prepared):
+            if _all_joints_move(prepared[:k] + prepared[k + 1 :]):
+                errors.append(_held_out_error(held_out, _fit(prepared[:k] + prepared[k + 1 :])))
+        if errors:
+            scores[cutoff] = float(np.mean(errors))
+    if not scores:
+        raise InputError("identify: cutoff_hz=auto found nothing to score it on (every joint "
+                         "must move in the fit logs without any one of them, logged at 7.5 Hz or "
+                         "more); pass cutoff_hz=")  # fmt: skip
+    return min(scores, key=scores.__getitem__), scores
+
+
+def _all_joints_move(prepared: Sequence[_Prepared]) -> bool:
+    qd = np.concatenate([p.motion.qd for p in prepared])
+    return bool((np.ptp(qd, axis=0) >= MOVING_RAD_S).all())
+
+
+def identify(arm: str, logs: Sequence[JointLog], cutoff_hz: float | None = None) -> Identified:
+    """Each joint's rotor inertia, viscous and Coulomb friction and torque constant, fitted on
+    ``logs`` (healthy running, no payload) pooled; the velocity low-passed at ``cutoff_hz``
+    (None: chosen by :func:`choose_cutoff`)."""
+    if not logs:
+        raise InputError("identify: no log to fit on")
+    scores = None
+    if cutoff_hz is None:
+        cutoff_hz, scores = choose_cutoff(arm, logs)
+    drives = _fit(_prepare(arm, logs, cutoff_hz))
+    with_model = all(log.model_torque is not None for log in logs)
+    notes = [] if with_model else ["no model torque in the logs: rotor inertia fitted on current"]
+    noise = effort_noise(logs, drives.torque_constant)
     if noise is None:
         notes.append("no hold of 1 s or more in the logs: the simulator's effort noise is kept")
-    rows = len(current)
+    rows = sum(len(log.t) for log in logs)
     seconds = float(sum(log.t[-1] - log.t[0] for log in logs))
-    return Identified(Drives(armature, damping, friction, k_t), rows, seconds, with_model, notes,
-                      noise)  # fmt: skip
+    return Identified(drives, rows, seconds, with_model, float(cutoff_hz), notes, noise, scores)
 
 
 def nrmse(simulated: np.ndarray, measured: np.ndarray) -> np.ndarray:
@@ -191,10 +280,10 @@ def nrmse(simulated: np.ndarray, measured: np.ndarray) -> np.ndarray:
     return np.sqrt(np.mean((simulated - measured) ** 2, axis=0)) / np.where(span > 0, span, 1.0)
 
 
-def friction_floor(logs: Sequence[JointLog]) -> tuple[np.ndarray, np.ndarray]:
+def friction_floor(logs: Sequence[JointLog], cutoff_hz: float) -> tuple[np.ndarray, np.ndarray]:
     """The controller's own model as a current predictor: per joint, ``i`` on ``[target moment,
     qd, sign(qd)]`` fitted on ``logs``; ``([6, 3] coefficients, [6] torque constants)``."""
-    motions = [motion(log) for log in logs]
+    motions = [motion(log, cutoff_hz) for log in logs]
     tau = np.concatenate([log.model_torque for log in logs])
     qd = np.concatenate([m.qd for m in motions])
     sign = np.concatenate([m.sign for m in motions])
@@ -204,11 +293,17 @@ def friction_floor(logs: Sequence[JointLog]) -> tuple[np.ndarray, np.ndarray]:
     return coef, 1.0 / np.where(coef[:, 0] > 0, coef[:, 0], np.nan)
 
 
-def fidelity(arm: str, log: JointLog, drives: Drives, floor: np.ndarray | None = None) -> dict:
+def fidelity(
+    arm: str,
+    log: JointLog,
+    drives: Drives,
+    cutoff_hz: float,
+    floor: tuple[np.ndarray, np.ndarray] | None = None,
+) -> dict:
     """NRMSE per joint of the simulated torque against the log's: the model torque against the
     controller's target moment, the whole torque against current x k_t (``drives``' k_t), and
     the floor (target moment and fitted friction against the same) where ``floor`` is given."""
-    m = motion(log)
+    m = motion(log, cutoff_hz)
     rigid = rigid_torques(arm, m)
     k_t = drives.torque_constant
     out = {"log": log.name, "seconds": round(float(log.t[-1]), 1)}
