@@ -147,12 +147,14 @@ class ContactBank:
 
 def _median(values: np.ndarray) -> np.ndarray:
     """The median over axis 1 of ``[W, A, J]``, NaN left out (at least one value each): one
-    sort for every stream, where ``np.nanmedian`` loops over them in Python."""
-    count = (~np.isnan(values)).sum(axis=1, keepdims=True)  # [W, 1, J]
-    ordered = np.sort(values, axis=1)  # NaN sorts last
-    low = np.take_along_axis(ordered, (count - 1) // 2, axis=1)
-    high = np.take_along_axis(ordered, count // 2, axis=1)
-    return 0.5 * (low + high)[:, 0]
+    sort for every stream, where ``np.nanmedian`` loops over them in Python, along a contiguous
+    last axis (``[W, J, A]``), which sorts in about half the time of the middle one."""
+    by_joint = np.ascontiguousarray(values.transpose(0, 2, 1))  # [W, J, A]
+    count = (~np.isnan(by_joint)).sum(axis=2, keepdims=True)  # [W, J, 1]
+    ordered = np.sort(by_joint, axis=2)  # NaN sorts last
+    low = np.take_along_axis(ordered, (count - 1) // 2, axis=2)
+    high = np.take_along_axis(ordered, count // 2, axis=2)
+    return 0.5 * (low + high)[:, :, 0]
 
 
 def quiet_deviations(
