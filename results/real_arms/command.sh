@@ -192,3 +192,25 @@ for point in "" "--healthy-rate 0.99"; do
 done
 $PY experiments/real_arms/summarise.py --runs 'standard,standard_identified' \
   > results/real_arms/twin_identified.md
+# Stricter operating points for the cruise recipe (2026-11-27, eighteenth session): the five
+# seeds' cruise models commissioned on the joint-wise logs and the arm's own motion at healthy
+# rates 0.995 and 0.998 beside 0.99, then what each costs on the twin's held-out session
+# (cruise_strict.md; about 30 minutes on 2 cores after the blocks above)
+for rate in 0.995 0.998; do
+  for seed in 42 43 44 45 46; do
+    name=cruise
+    [ $seed = 42 ] || name=cruise_s$seed
+    $PY experiments/real_arms/campaign.py --variants stgnn_fixed --seed $seed --epochs 10 \
+      --curriculum cruise --name $name --commission jointwise+own_motion --healthy-rate $rate \
+      --observability motion
+  done
+done
+{ $PY experiments/real_arms/summarise.py --runs 'cruise,cruise_s4[3-6]'
+  for rate in 0.995 0.998; do
+    for seed in 42 43 44 45 46; do
+      name=cruise
+      [ $seed = 42 ] || name=cruise_s$seed
+      $PY experiments/real_arms/sensitivity.py --runs $name --seed $seed --suffix _ownmotion_rate$rate
+      echo
+    done
+  done; } > results/real_arms/cruise_strict.md
