@@ -34,8 +34,8 @@ models ``<run>/models/`` and per model and log the monitor's verdict (``<run>/ve
 step skips what is done; a recording made on another twin than the one named stops the run.
 ``--swap VARIANT`` prints where the real arm's healthy running looks faulty to a commissioned
 network, and why: each monitored log's motion is replayed on the healthy twin (tick for tick the
-same motion), and the network reads the real ticks, the simulated ticks,
-and the real ticks with one channel (or one joint's torque residual) taken from the simulation.
+same motion), and the network reads the real ticks, the simulated ticks, and the real ticks with
+one channel (or one joint's torque residual) taken from the simulation.
 A swap that brings the real share of ticks called faulty to the simulated one names where twin and
 arm differ; a simulated share as high as the real one says the model calls this motion faulty in
 simulation too (a gap between training program and motion, not between simulation and arm).

@@ -24,6 +24,7 @@ the twin's figure on that grid stands beside them.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from unittest import mock
@@ -63,7 +64,8 @@ def rows_as_evenly_spaced(log: JointLog, cutoff_hz: float) -> twin_identify.Moti
 
 
 @contextmanager
-def estimator(name: str):
+def estimator(name: str) -> Iterator[None]:
+    """Within it, identification estimates the acceleration the way ``name`` says."""
     if name == "rows as evenly spaced":
         with mock.patch.object(twin_identify, "motion", rows_as_evenly_spaced):
             yield
