@@ -23,8 +23,9 @@ three_seeds() {  # a curriculum and options: seed 42 as $CAMPAIGN, seeds 43 and 
 # grid under the uneven rows, the low-pass chosen on the fit logs) into identified/: twin.yaml,
 # fidelity.md; then how the estimator was chosen and what the logged motion cannot explain
 # (fidelity_limit.md). The campaigns below were measured on the twin identified on 2026-11-25,
-# before that estimator (results/real_arms/twin_2026-11-25.yaml: rotor inertia 2-5 % lower, the
-# rest within 0.7 %), so they record on it; campaign.py with no twin of its own identifies today's.
+# before that estimator (results/real_arms/twin_2026-11-25.yaml: rotor inertia 1.6-5.2 % lower,
+# the rest within 0.7 %), so they record on it; campaign.py with no twin of its own identifies
+# today's.
 L=outputs/real_arms/logs
 $PY -m robohealth_mj.identify arm=ur10e out=outputs/real_arms/identified \
   "fit=[$L/identification_data/ur-20_02_12-50sec_12harm.csv,$L/identification_data/ur-20_02_12-40sec_12harm.csv,$L/identification_data/ur-20_02_10-30sec_12harm.csv]" \
