@@ -408,7 +408,8 @@ class FleetRuntime:
                 reasons[k] = self.problem or "no model"
             self.last_t[gs], self.last_index[gs] = gt, gi
             return 0.0
-        gap_rows = rows[good][gap]
+        gr = rows[good]
+        gap_rows = gr[gap]
         for k, slot, new in zip(gap_rows.tolist(), gs[gap].tolist(), gi[gap].tolist(), strict=True):
             reasons[k] = (
                 f"gap in sample_index ({int(self.last_index[slot])} -> {new}) or over "
@@ -421,24 +422,23 @@ class FleetRuntime:
             if self.contact is not None:
                 self.contact.reset(gs[gap])
         self.last_t[gs], self.last_index[gs] = gt, gi
+        xg = x[good]  # one copy of the valid rows for every step below
         if self.observability == "motion":
-            fast = np.abs(x[good][:, : schema.N_JOINTS, _VEL]) > MOVING_RAD_S  # [g, J]
+            fast = np.abs(xg[:, : schema.N_JOINTS, _VEL]) > MOVING_RAD_S  # [g, J]
             self.last_moved[gs] = np.where(fast, gi[:, None], self.last_moved[gs])
         if self.contact is not None:  # every valid row, before its window is full too
-            out["contact"][rows[good]], out["contact_joint"][rows[good]] = self.contact.update(
-                gs, x[good]
-            )
+            out["contact"][gr], out["contact_joint"][gr] = self.contact.update(gs, xg)
         self._clock.mark("validate, bookkeeping")
         start = time.perf_counter()
         decide = final[good]
-        full, outputs = self._model_step(gs, x[good], decide)
+        full, outputs = self._model_step(gs, xg, decide)
         elapsed = (time.perf_counter() - start) * 1e3
         self._clock.start()  # the model step's phases were charged on the threads that ran them
-        warming = rows[good][~full & ~gap]
+        warming = gr[~full & ~gap]
         out["status"][warming] = WARMING
         for k in warming.tolist():
             reasons[k] = "warming up: window not full yet"
-        buffered = rows[good][full & ~decide]
+        buffered = gr[full & ~decide]
         out["status"][buffered] = BUFFERED
         for k in buffered.tolist():
             reasons[k] = "burst: buffered; decided with this stream's last sample of the tick"
@@ -453,7 +453,7 @@ class FleetRuntime:
             probs = hide_unobservable(probs, joint_scores, moved, self.classes)
         accumulated = self.evidence.update(ready, probs)
         state, alarm, joint = self.alarms.update(ready, accumulated, joint_scores)
-        target = rows[good][full]
+        target = gr[full]
         out["status"][target] = DECIDED
         out["probs"][target], out["joint_scores"][target] = probs, joint_scores
         out["accumulated"][target] = accumulated
