@@ -1,0 +1,259 @@
+"""Where a push was: the joint the contact watch names against a force fit on the arm's
+kinematics (:mod:`robohealth_mj.twin.contact_fit`), where the truth is known and on the real
+pushes, where it is not.
+
+    python experiments/real_arms/contact_where.py [--run cruise]
+        > results/real_arms/contact_where.md
+
+The watch, and the hindsight finder the real pushes were scored against (``events.py``), both
+name the most distal joint a push loads. A hand pressing square on a joint's round housing
+pushes through that joint's axis and loads it not at all, so that rule can name a joint short of
+the push. Three parts, each with the watch's rule beside the fit's:
+
+1. The twin, simulated (selection): it holds a pose and is pushed for 1 s at points drawn on
+   each link's collision surface (a geom by its area), with a force drawn uniformly inside the
+   friction cone there (60-120 N on the shoulder, upper arm and forearm, 30-60 N on the wrists).
+   The truth is the link pushed. The fit's acceptance is chosen here: the most pushes named
+   right, then the smaller.
+2. The real pushes (found in hindsight, :mod:`robohealth_mj.twin.pushes`): what the finder, the
+   watch and the fit each name. No truth: the logs say neither where nor how.
+3. Kinematics alone, at the real arm's two held poses: pushes drawn the same way, their joint
+   torques ``J^T F`` with the real arm's thresholds and noise (the largest quiet deviation of its
+   commissioning running per joint; a normal draw of half that is added): read after.
+
+A push's torques: each joint's residual against its median 3 s to 1 s before the push, the
+median over the push's ticks where it is at least half its largest, with the sign turned (the
+drives hold against the push).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections import Counter
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from robohealth_mj import schema
+from robohealth_mj.common.config import compose_config
+from robohealth_mj.logs import log_samples
+from robohealth_mj.recording.recorder import build_simulator, chunk_features
+from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, quiet_deviations
+from robohealth_mj.sim.dynamics import nominal_model
+from robohealth_mj.sim.ratings import rated_torque_nm
+from robohealth_mj.twin import contact_fit
+from robohealth_mj.twin.pushes import nearest_joint, pushes
+
+ROOT = Path("outputs/real_arms")
+ARM = "ur10e"
+SEED = 7
+MARGIN = 2.0  # the watch's thresholds: this times each joint's largest quiet deviation
+SHARE = 0.05  # the finder's push: a joint more than this share of its rating off its level
+ACCEPT = (1.0, 2.0, 4.0, 8.0)
+TICK_HZ = 20.0
+POS, RESIDUAL = schema.feature_index("pos"), schema.feature_index("effort_residual")
+TWIN = ["arm=ur10e", f"sim.twin={ROOT}/twin/twin.yaml", "sim.mount_height_m=0.8", "seed=3",
+        "session.progress=false", "faults=none", "curriculum.families=[hold]"]  # fmt: skip
+PUSH_AT_S, PUSH_S, HOLD_S = 6.0, 1.0, 12.0
+FORCE_N = {True: (60.0, 120.0), False: (30.0, 60.0)}  # big links, wrists
+TWIN_PER_LINK, KINEMATIC_PER_LINK = 8, 12
+
+
+def drawn_push(model: mujoco.MjModel, joint: int, rng: np.random.Generator) -> tuple:
+    """A push on the link ``joint`` moves: ``(point, force)`` in the link's body frame, at a
+    point of its collision surface (each geom by its area), pushing in a direction drawn
+    uniformly inside the friction cone there."""
+    body = int(model.joint(f"{schema.JOINT_NAMES[joint]}_joint").bodyid[0])
+    geoms = np.flatnonzero(model.geom_bodyid == body)
+    areas = np.array([contact_fit.area(model, g) for g in geoms])
+    geom = int(rng.choice(geoms, p=areas / areas.sum()))
+    points, normals = contact_fit.surface(model, geom)
+    k = int(rng.integers(len(points)))
+    turn = np.empty(9)
+    mujoco.mju_quat2Mat(turn, model.geom_quat[geom])
+    turn = turn.reshape(3, 3)
+    normal = turn @ normals[k]
+    t1, t2 = contact_fit.tangents(normal)
+    slide, angle = contact_fit.FRICTION * np.sqrt(rng.random()), rng.uniform(0, 2 * np.pi)
+    force = -normal + slide * (np.cos(angle) * t1 + np.sin(angle) * t2)
+    force *= rng.uniform(*FORCE_N[joint < 3]) / np.linalg.norm(force)
+    return model.geom_pos[geom] + turn @ points[k], force
+
+
+def push_torque(x: np.ndarray, first: int, last: int) -> tuple[np.ndarray, np.ndarray]:
+    """The pose ``[6]`` and the push's external torque on the joints ``[6]`` (N·m) over ticks
+    first..last: minus the residual's change, as the drives hold against it."""
+    residual = x[:, : schema.N_JOINTS, RESIDUAL].astype(np.float64)
+    level = np.median(residual[max(0, first - 60) : first - 20], axis=0)
+    off = residual[first : last + 1] - level
+    size = np.abs(off).max(axis=1)
+    pose = x[(first + last) // 2, : schema.N_JOINTS, POS]
+    return pose, -np.median(off[size >= 0.5 * size.max()], axis=0)
+
+
+def watch_named(x: np.ndarray, threshold: np.ndarray, first: int, last: int) -> int | None:
+    """The joint the watch names most over ticks first..last (None: no contact called)."""
+    bank = ContactBank(ContactPolicy(), threshold, ARM, 1)
+    slot = np.zeros(1, np.int64)
+    named = [int(bank.update(slot, tick[None])[1][0]) for tick in x]
+    called = Counter(j for j in named[first : last + 1] if j >= 0).most_common(1)
+    return called[0][0] if called else None
+
+
+def fit_named(q: np.ndarray, torque: np.ndarray, noise: np.ndarray) -> tuple[dict, list]:
+    """Per acceptance, the joint the fit names (None: no single push explains the torques), and
+    the fits."""
+    fits = contact_fit.fit_links(ARM, q, torque, noise)
+    names = {a: contact_fit.nearest_link(fits, a) for a in ACCEPT}
+    return {a: schema.JOINT_NAMES.index(f.joint) if f else None for a, f in names.items()}, fits
+
+
+def short(joint: int | None) -> str:
+    return "-" if joint is None else schema.JOINT_NAMES[joint]
+
+
+def held(push: tuple | None, link: str = "") -> np.ndarray:
+    """The twin holding a pose, pushed at ``push`` (body-frame point, force) on ``link`` or not."""
+    extra = []
+    if push is not None:
+        point, force = (np.round(v, 4).tolist() for v in push)
+        extra = [f"session.pushes=[{{at_s: {PUSH_AT_S}, for_s: {PUSH_S}, link: {link}, "
+                 f"force_n: {force}, point_m: {point}}}]"]  # fmt: skip
+    sim = build_simulator(compose_config("record", [*TWIN, *extra]))
+    return np.concatenate([chunk_features(c) for c in sim.run(round(HOLD_S / sim.tick_s))])
+
+
+def tally(rows: list[tuple[int, int | None, dict]]) -> str:
+    """'right of called' for the watch and for the fit at each acceptance."""
+    called = [r for r in rows if r[1] is not None]
+    cells = [f"{sum(r[1] == r[0] for r in called)} / {len(called)}"]
+    cells += [f"{sum(r[2][a] == r[0] for r in called)} / {len(called)}" for a in ACCEPT]
+    return " | ".join(cells)
+
+
+def twin_part(rng: np.random.Generator) -> float:
+    """Part 1; returns the acceptance it selects."""
+    model, _ = nominal_model(ARM)
+    unpushed = held(None)
+    noise = quiet_deviations([unpushed], ARM)
+    threshold = MARGIN * noise
+    first, last = round(PUSH_AT_S * TICK_HZ), round((PUSH_AT_S + PUSH_S) * TICK_HZ)
+    rows, lines = [], []
+    for joint in range(schema.N_JOINTS):
+        link = model.body(int(model.joint(f"{schema.JOINT_NAMES[joint]}_joint").bodyid[0])).name
+        for _ in range(TWIN_PER_LINK):
+            push = drawn_push(model, joint, rng)
+            x = held(push, link)
+            q, torque = push_torque(x, first, last)
+            watch = watch_named(x, threshold, first, last)
+            named, fits = fit_named(q, torque, noise)
+            rows.append((joint, watch, named))
+            lines.append((f"{link} ({schema.JOINT_NAMES[joint]})", np.linalg.norm(push[1]),
+                          watch, named, " / ".join(f"{f.chi2:.1f}" for f in fits)))  # fmt: skip
+    called = [r for r in rows if r[1] is not None]
+    accept = max(ACCEPT, key=lambda a: (sum(r[2][a] == r[0] for r in called), -a))
+    print("## 1. The twin pushed (truth known; selection)\n")
+    print(f"Thresholds from its unpushed hold (N·m): {np.round(threshold, 2).tolist()}.\n")
+    print("| | watch | " + " | ".join(f"fit, accept {a:g}" for a in ACCEPT) + " |")
+    print("|---|---|" + "---|" * len(ACCEPT))
+    print(f"| named right, of the pushes the watch called | {tally(rows)} |\n")
+    print(f"Selected: accept {accept:g}. Push by push:\n")
+    print(f"| link pushed (its joint) | force N | watch names | fit names (accept {accept:g}) "
+          "| chi-square per link, base to flange |")  # fmt: skip
+    print("|---|---|---|---|---|")
+    for pushed, newtons, watch, named, chi2 in lines:
+        print(f"| {pushed} | {newtons:.0f} | {short(watch)} | {short(named[accept])} | {chi2} |")
+    print()
+    return accept
+
+
+def kinematic_part(rng: np.random.Generator, poses: dict, noise: np.ndarray) -> None:
+    model, index = nominal_model(ARM)
+    data = mujoco.MjData(model)
+    jac = np.zeros((3, model.nv))
+    threshold = MARGIN * noise
+    print("## 3. Kinematics alone, at the real arm's held poses (read after)\n")
+    print(
+        f"{KINEMATIC_PER_LINK} pushes per link and pose; the real arm's thresholds (N·m): "
+        f"{np.round(threshold, 2).tolist()}; pushes no threshold calls are left out.\n"
+    )
+    print("| pose | link's joint | called | watch right | "
+          + " | ".join(f"fit right, accept {a:g}" for a in ACCEPT) + " |")  # fmt: skip
+    print("|---|---|---|---|" + "---|" * len(ACCEPT))
+    every = []
+    for pose, q in poses.items():
+        index.set_link_pose(data, q)
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        for joint in range(schema.N_JOINTS):
+            body = int(model.joint(f"{schema.JOINT_NAMES[joint]}_joint").bodyid[0])
+            rows = []
+            for _ in range(KINEMATIC_PER_LINK):
+                point, force = drawn_push(model, joint, rng)
+                turn = data.xmat[body].reshape(3, 3)
+                where = data.xpos[body] + turn @ point
+                mujoco.mj_jac(model, data, jac, None, where, body)
+                torque = jac[:, index.motor_dof].T @ (turn @ force)
+                torque = torque + rng.normal(0.0, 0.5, schema.N_JOINTS) * noise
+                over = np.flatnonzero(np.abs(torque) > threshold)
+                watch = int(over.max()) if len(over) else None
+                rows.append((joint, watch, fit_named(q, torque, noise)[0] if len(over) else {}))
+            every += rows
+            called = sum(r[1] is not None for r in rows)
+            print(
+                f"| {pose} | {schema.JOINT_NAMES[joint]} | {called} | {tally(rows)} |", flush=True
+            )
+    print(f"| both | all | {sum(r[1] is not None for r in every)} | {tally(every)} |\n")
+
+
+def real_part(logs: list[Path], noise: np.ndarray, accept: float) -> dict:
+    print("## 2. The real pushes (no truth)\n")
+    print(f"The fit at accept {accept:g}, chosen on part 1.\n")
+    print("| log | push at s | finder (most distal joint > 5 % of its rating) | watch names "
+          "| fit names | chi-square per link, base to flange | force N |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    rated = rated_torque_nm(ARM)
+    poses = {}
+    for log in logs:
+        x = np.stack([s.x for s in log_samples(log)])
+        poses[log.stem[-6:]] = x[0, : schema.N_JOINTS, POS].astype(np.float64)
+        off, found = pushes(x[:, : schema.N_JOINTS, RESIDUAL], rated, SHARE)
+        for first, last in found:
+            q, torque = push_torque(x, first, last)
+            named, fits = fit_named(q, torque, noise)
+            best = next((f for f in fits if f.joint == short(named[accept])), None)
+            force = f"{np.linalg.norm(best.force_n):.0f}" if best else "-"
+            print(f"| {log.stem} | {first / TICK_HZ:.1f} | "
+                  f"{schema.JOINT_NAMES[nearest_joint(off[first : last + 1], SHARE)]} | "
+                  f"{short(watch_named(x, MARGIN * noise, first, last))} | "
+                  f"{short(named[accept])} | " + " / ".join(f"{f.chi2:.1f}" for f in fits)
+                  + f" | {force} |", flush=True)  # fmt: skip
+    return poses
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--run", default="cruise", help="the campaign run whose commissioning "
+                        "logs give the real arm's thresholds")  # fmt: skip
+    args = parser.parse_args()
+    record = next((ROOT / args.run / "models").rglob(
+        "stgnn_fixed/w32/seed42/commissioned_ownmotion_rate0.99/commissioning.json"))  # fmt: skip
+    commissioning = [np.stack([s.x for s in log_samples(Path(p))])
+                     for p in json.loads(record.read_text())["healthy"]]  # fmt: skip
+    noise = quiet_deviations(commissioning, ARM)
+    rng = np.random.default_rng(SEED)
+    print("# Where a push was: the contact watch's joint against a force fit\n")
+    print("Command: `python experiments/real_arms/contact_where.py` (after `command.sh` has made "
+          f"run `{args.run}`). Noise per joint: the largest quiet deviation of the healthy "
+          "running (the watch's threshold over its margin); chi-square: the torques' misfit "
+          "in those units, summed over the joints.\n")  # fmt: skip
+    accept = twin_part(rng)
+    poses = real_part(sorted((ROOT / "logs/collision").glob("*.csv")), noise, accept)
+    print()
+    kinematic_part(rng, poses, noise)
+
+
+if __name__ == "__main__":
+    main()
