@@ -27,12 +27,11 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
-import subprocess
-import sys
 from functools import cache
 from pathlib import Path
 
 from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.steps import run_step
 from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.deploy.alarm_sweep import evaluate_policy, replay_many
 from robohealth_mj.monitor import load_config
@@ -45,13 +44,8 @@ ARMS = ("ur3e", "ur5e", "ur10e", "ur16e")
 HEALTHY_HOUR = ("healthy_hour_seed950", "healthy_hour_seed951", "healthy_hour_seed952")
 
 
-def run(*args: str) -> None:
-    print("+", " ".join(args), flush=True)
-    subprocess.run([sys.executable, "-m", *args], check=True)
-
-
 def train(sweep: Path, train: list[str], heldout: Path, args: argparse.Namespace, *extra: str):
-    run(
+    run_step(
         "robohealth_mj.train",
         "-m",
         f"variant={args.variants}",
@@ -114,17 +108,17 @@ def commission_and_score(run_dir: Path, arm_dir: Path, healthy_rate: float | Non
     done = commissioned_dir(run_dir, healthy_rate)
     rate = [] if healthy_rate is None else [f"healthy_rate={healthy_rate:g}"]
     if not (done / "best.ckpt").is_file():
-        run("robohealth_mj.commission", f"model={run_dir / 'best.ckpt'}",
-            f"healthy={arm_dir / 'healthy_commissioning_seed940'}", f"out={done}",
-            *rate)  # fmt: skip
+        run_step("robohealth_mj.commission", f"model={run_dir / 'best.ckpt'}",
+                 f"healthy={arm_dir / 'healthy_commissioning_seed940'}", f"out={done}",
+                 *rate)  # fmt: skip
     if not (done / "eval_heldout.json").is_file():
         score(done, arm_dir)
 
 
 def score(run_dir: Path, arm_dir: Path) -> None:
     """``run_dir``'s checkpoint on the held-out session of ``arm_dir``, as ``eval_heldout.json``."""
-    run("robohealth_mj.evaluate", f"ckpt={run_dir / 'best.ckpt'}",
-        f"data={arm_dir / 'heldout_seed900'}", f"out={run_dir / 'eval_heldout'}")  # fmt: skip
+    run_step("robohealth_mj.evaluate", f"ckpt={run_dir / 'best.ckpt'}",
+             f"data={arm_dir / 'heldout_seed900'}", f"out={run_dir / 'eval_heldout'}")  # fmt: skip
 
 
 def healthy_alarms(done: Path, arm_dir: Path) -> None:

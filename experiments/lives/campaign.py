@@ -20,8 +20,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -29,6 +27,7 @@ import numpy as np
 import torch
 
 from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.steps import run_step
 from robohealth_mj.learn.evaluation import score_checkpoint
 from robohealth_mj.learn.trainer import CHECKPOINT
 from robohealth_mj.prognostics import metrics
@@ -54,9 +53,7 @@ def train(
     ckpt = run_dir / "model" / CHECKPOINT
     if ckpt.is_file():
         return ckpt
-    cmd = [
-        sys.executable,
-        "-m",
+    run_step(
         "robohealth_mj.train",
         f"variant={variant}",
         f"seed={seed}",
@@ -68,8 +65,7 @@ def train(
         "trainer.progress=false",
         f"trainer.epochs={epochs}",
         *overrides,
-    ]
-    subprocess.run(cmd, check=True)
+    )
     return ckpt
 
 

@@ -47,8 +47,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +54,7 @@ import numpy as np
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_text
 from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.common.steps import run_step
 from robohealth_mj.runtime.runtime import ModelRuntime
 from robohealth_mj.runtime.sources import replay_stream
 from robohealth_mj.sim.twin_file import mark_recorded, recorded_on
@@ -143,11 +142,6 @@ def events() -> dict[str, list[Path]]:
     }  # fmt: skip
 
 
-def run(*args: str) -> None:
-    print("+", " ".join(args), flush=True)
-    subprocess.run([sys.executable, "-m", *args], check=True)
-
-
 def as_list(paths: list[Path]) -> str:
     return "[" + ",".join(str(p) for p in paths) + "]"
 
@@ -224,8 +218,8 @@ def record_corpus(corpus_name: str, twin: Path, tag: str, stiction: bool = False
     overrides = ["arm=ur10e", f"sim.twin={twin}", f"sim.mount_height_m={MOUNT_M}", *extra]
     overrides += STICTION if stiction else []
     if not recorded_on(corpus, corpus / "corpus.json", twin):
-        run("robohealth_mj.corpus", f"corpus={config}", f"out_dir={corpus}",
-            f"record_overrides={json.dumps(overrides)}", "progress=false")  # fmt: skip
+        run_step("robohealth_mj.corpus", f"corpus={config}", f"out_dir={corpus}",
+                 f"record_overrides={json.dumps(overrides)}", "progress=false")  # fmt: skip
         mark_recorded(corpus, twin)
     return corpus
 
@@ -239,12 +233,11 @@ def simulated(log: Path, twin: Path, out: Path) -> Path:
     graphs = out / "graphs.jsonl"
     if not recorded_on(out, graphs, twin):
         seconds = float(np.loadtxt(log, delimiter=",", usecols=0, ndmin=1)[[0, -1]] @ [-1, 1])
-        subprocess.run([sys.executable, "-m", "robohealth_mj.record", "arm=ur10e",
-                        f"sim.twin={twin}", f"sim.mount_height_m={MOUNT_M}", "curriculum=replay",
-                        f"curriculum.files=[{log}]", "curriculum.passes=1", "curriculum.hold_s=0",
-                        "faults=none", f"session.duration_s={seconds + LEAD_S + 0.5:.2f}",
-                        "seed=1", f"session.out_dir={out}", "session.progress=false"],
-                       check=True, stdout=subprocess.DEVNULL)  # fmt: skip
+        run_step("robohealth_mj.record", "arm=ur10e", f"sim.twin={twin}",
+                 f"sim.mount_height_m={MOUNT_M}", "curriculum=replay", f"curriculum.files=[{log}]",
+                 "curriculum.passes=1", "curriculum.hold_s=0", "faults=none",
+                 f"session.duration_s={seconds + LEAD_S + 0.5:.2f}", "seed=1",
+                 f"session.out_dir={out}", "session.progress=false", quiet=True)  # fmt: skip
         mark_recorded(out, twin)
     return graphs
 
@@ -370,20 +363,20 @@ def main() -> None:
         raise SystemExit(f"no logs in {LOGS}: run experiments/real_arms/fetch.sh")
     twin = args.twin or ROOT / "twin" / "twin.yaml"
     if not twin.is_file():
-        run("robohealth_mj.identify", "arm=ur10e", f"fit={as_list(LOGS_ROLES['fit'])}",
-            f"validate={as_list(LOGS_ROLES['validate'])}", f"out={twin.parent}")  # fmt: skip
+        run_step("robohealth_mj.identify", "arm=ur10e", f"fit={as_list(LOGS_ROLES['fit'])}",
+                 f"validate={as_list(LOGS_ROLES['validate'])}", f"out={twin.parent}")  # fmt: skip
     tag = f"_{args.twin.stem}" if args.twin else ""
     first, second = halves(OWN_MOTION)  # the replay_own_motion corpus replays the first half
     corpora = [record_corpus(c, twin, tag, args.stiction) for c in CURRICULA[args.curriculum]]
     train = ",".join(f"{c}/train_*" for c in corpora)
     sweep = ROOT / name / "models"
     if not any(sweep.rglob("best.ckpt")):
-        run("robohealth_mj.train", "-m", f"variant={args.variants}", f"seed={args.seed}",
-            "sensing=stock_reduced", "window=32", f"data.train=[{train}]",
-            f"data.evaluate.heldout={corpora[-1]}/heldout_seed900", "data.evaluate.probe=null",
-            f"trainer.epochs={args.epochs}", f"labels={args.labels}", "trainer.threads=1",
-            "trainer.progress=false",
-            "hydra/launcher=local", f"hydra.sweep.dir={sweep}")  # fmt: skip
+        run_step("robohealth_mj.train", "-m", f"variant={args.variants}", f"seed={args.seed}",
+                 "sensing=stock_reduced", "window=32", f"data.train=[{train}]",
+                 f"data.evaluate.heldout={corpora[-1]}/heldout_seed900", "data.evaluate.probe=null",
+                 f"trainer.epochs={args.epochs}", f"labels={args.labels}", "trainer.threads=1",
+                 "trainer.progress=false",
+                 "hydra/launcher=local", f"hydra.sweep.dir={sweep}")  # fmt: skip
     commissioning = [p for role in COMMISSION[args.commission] for p in LOGS_ROLES[role]]
     monitored = healthy_monitored()
     if args.commission == "jointwise+own_motion" or args.second_half:
@@ -399,9 +392,9 @@ def main() -> None:
             continue
         done = ckpt.parent / f"commissioned{suffix}"
         if not (done / "best.ckpt").is_file():
-            run("robohealth_mj.commission", f"model={ckpt}", "arm=ur10e",
-                f"healthy={as_list(commissioning)}", f"out={done}",
-                f"healthy_rate={args.healthy_rate or 'null'}")  # fmt: skip
+            run_step("robohealth_mj.commission", f"model={ckpt}", "arm=ur10e",
+                     f"healthy={as_list(commissioning)}", f"out={done}",
+                     f"healthy_rate={args.healthy_rate or 'null'}")  # fmt: skip
         # the program logs: healthy real running no run is judged on, so runs are compared on
         # it (selection); in-sample for the curricula that replay it
         targets = [("program", p) for p in LOGS_ROLES["program"]]
@@ -413,13 +406,13 @@ def main() -> None:
                 continue
             out.parent.mkdir(parents=True, exist_ok=True)
             if (done / "model.onnx").is_file():
-                run("robohealth_mj.monitor", "source=replay", f"model={done / 'model.onnx'}",
-                    f"file={log}", "evaluate=true", "quiet=true", f"out={out}",
-                    f"observability={args.observability}")  # fmt: skip
+                run_step("robohealth_mj.monitor", "source=replay", f"model={done / 'model.onnx'}",
+                         f"file={log}", "evaluate=true", "quiet=true", f"out={out}",
+                         f"observability={args.observability}")  # fmt: skip
             else:  # a tree ensemble has no streaming form: its window decisions on the log
-                run("robohealth_mj.evaluate", f"ckpt={done / 'best.ckpt'}", f"data={log}",
-                    f"out={out.with_suffix('')}",
-                    f"observability={args.observability}")  # fmt: skip
+                run_step("robohealth_mj.evaluate", f"ckpt={done / 'best.ckpt'}", f"data={log}",
+                         f"out={out.with_suffix('')}",
+                         f"observability={args.observability}")  # fmt: skip
     print(json.dumps({"verdicts": str(verdicts)}))
 
 

@@ -19,14 +19,13 @@ spread the standard deviation. Units: N m, as logged and recorded.
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.common.steps import run_step
 from robohealth_mj.runtime.sources import replay_stream
 from robohealth_mj.sim.twin_file import mark_recorded, recorded_on
 
@@ -66,12 +65,10 @@ def simulated(name: str, overrides: list[str]) -> Path:
     out = ROOT / "rest" / name
     graphs = out / "graphs.jsonl"
     if not recorded_on(out, graphs, TWIN):
-        subprocess.run([sys.executable, "-m", "robohealth_mj.record", "arm=ur10e",
-                        f"sim.twin={TWIN}", f"sim.mount_height_m={MOUNT_M}",
-                        "curriculum.families=[hold]", "faults=none",
-                        f"session.duration_s={SIM_SECONDS}", "seed=3", f"session.out_dir={out}",
-                        "session.progress=false", *overrides],
-                       check=True, stdout=subprocess.DEVNULL)  # fmt: skip
+        run_step("robohealth_mj.record", "arm=ur10e", f"sim.twin={TWIN}",
+                 f"sim.mount_height_m={MOUNT_M}", "curriculum.families=[hold]", "faults=none",
+                 f"session.duration_s={SIM_SECONDS}", "seed=3", f"session.out_dir={out}",
+                 "session.progress=false", *overrides, quiet=True)  # fmt: skip
         mark_recorded(out, TWIN)
     return graphs
 
