@@ -1,5 +1,5 @@
 """Where a push was: the joint the contact watch names against a force fit on the arm's
-kinematics (:mod:`robohealth_mj.twin.contact_fit`), where the truth is known and on the real
+kinematics (:mod:`robohealth_mj.sim.contact_place`), where the truth is known and on the real
 pushes, where it is not.
 
     python experiments/real_arms/contact_where.py [--run cruise]
@@ -40,10 +40,12 @@ from robohealth_mj import schema
 from robohealth_mj.common.config import compose_config
 from robohealth_mj.logs import log_samples
 from robohealth_mj.recording.recorder import build_simulator, chunk_features
-from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, quiet_deviations
+from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, Placing, quiet_deviations
+from robohealth_mj.sim.contact_place import ACCEPT as PLACE_ACCEPT
+from robohealth_mj.sim.contact_place import FRICTION, place, tangents
+from robohealth_mj.sim.contact_surface import arm_surface, geom_area, geom_in_body, geom_surface
 from robohealth_mj.sim.dynamics import nominal_model
 from robohealth_mj.sim.ratings import rated_torque_nm
-from robohealth_mj.twin import contact_fit
 from robohealth_mj.twin.pushes import nearest_joint, pushes
 
 ROOT = Path("outputs/real_arms")
@@ -59,6 +61,7 @@ TWIN = ["arm=ur10e", f"sim.twin={ROOT}/twin/twin.yaml", "sim.mount_height_m=0.8"
 PUSH_AT_S, PUSH_S, HOLD_S = 6.0, 1.0, 12.0
 FORCE_N = {True: (60.0, 120.0), False: (30.0, 60.0)}  # big links, wrists
 TWIN_PER_LINK, KINEMATIC_PER_LINK = 8, 12
+SURFACE = arm_surface(ARM)
 
 
 def drawn_push(model: mujoco.MjModel, joint: int, rng: np.random.Generator) -> tuple:
@@ -67,19 +70,17 @@ def drawn_push(model: mujoco.MjModel, joint: int, rng: np.random.Generator) -> t
     uniformly inside the friction cone there."""
     body = int(model.joint(f"{schema.JOINT_NAMES[joint]}_joint").bodyid[0])
     geoms = np.flatnonzero(model.geom_bodyid == body)
-    areas = np.array([contact_fit.area(model, g) for g in geoms])
+    areas = np.array([geom_area(model, g) for g in geoms])
     geom = int(rng.choice(geoms, p=areas / areas.sum()))
-    points, normals = contact_fit.surface(model, geom)
+    points, normals = geom_surface(model, geom)
     k = int(rng.integers(len(points)))
-    turn = np.empty(9)
-    mujoco.mju_quat2Mat(turn, model.geom_quat[geom])
-    turn = turn.reshape(3, 3)
+    pos, turn = geom_in_body(model, geom)
     normal = turn @ normals[k]
-    t1, t2 = contact_fit.tangents(normal)
-    slide, angle = contact_fit.FRICTION * np.sqrt(rng.random()), rng.uniform(0, 2 * np.pi)
+    t1, t2 = (t[0] for t in tangents(normal[None]))
+    slide, angle = FRICTION * np.sqrt(rng.random()), rng.uniform(0, 2 * np.pi)
     force = -normal + slide * (np.cos(angle) * t1 + np.sin(angle) * t2)
     force *= rng.uniform(*FORCE_N[joint < 3]) / np.linalg.norm(force)
-    return model.geom_pos[geom] + turn @ points[k], force
+    return pos + turn @ points[k], force
 
 
 def push_torque(x: np.ndarray, first: int, last: int) -> tuple[np.ndarray, np.ndarray]:
@@ -93,21 +94,27 @@ def push_torque(x: np.ndarray, first: int, last: int) -> tuple[np.ndarray, np.nd
     return pose, -np.median(off[size >= 0.5 * size.max()], axis=0)
 
 
-def watch_named(x: np.ndarray, threshold: np.ndarray, first: int, last: int) -> int | None:
-    """The joint the watch names most over ticks first..last (None: no contact called)."""
-    bank = ContactBank(ContactPolicy(), threshold, ARM, 1)
+def watch_named(
+    x: np.ndarray, threshold: np.ndarray, first: int, last: int, placing: Placing | None = None
+) -> int | None:
+    """The joint the watch names most over ticks first..last (None: no contact called), by the
+    most distal joint over its threshold or, given ``placing``, as deployed since 2026-11-27."""
+    bank = ContactBank(ContactPolicy(), threshold, ARM, 1, placing)
     slot = np.zeros(1, np.int64)
     named = [int(bank.update(slot, tick[None])[1][0]) for tick in x]
     called = Counter(j for j in named[first : last + 1] if j >= 0).most_common(1)
     return called[0][0] if called else None
 
 
-def fit_named(q: np.ndarray, torque: np.ndarray, noise: np.ndarray) -> tuple[dict, list]:
+def fit_named(q: np.ndarray, torque: np.ndarray, noise: np.ndarray) -> tuple[dict, object]:
     """Per acceptance, the joint the fit names (None: no single push explains the torques), and
-    the fits."""
-    fits = contact_fit.fit_links(ARM, q, torque, noise)
-    names = {a: contact_fit.nearest_link(fits, a) for a in ACCEPT}
-    return {a: schema.JOINT_NAMES.index(f.joint) if f else None for a, f in names.items()}, fits
+    the placement (chi-square and force per link)."""
+    placed = place(SURFACE, q, torque, noise, accept=np.inf)
+    names = {}
+    for a in ACCEPT:
+        fits = np.flatnonzero(placed.chi2 <= a)
+        names[a] = int(fits[0]) if len(fits) else None
+    return names, placed
 
 
 def short(joint: int | None) -> str:
@@ -125,10 +132,13 @@ def held(push: tuple | None, link: str = "") -> np.ndarray:
     return np.concatenate([chunk_features(c) for c in sim.run(round(HOLD_S / sim.tick_s))])
 
 
-def tally(rows: list[tuple[int, int | None, dict]]) -> str:
-    """'right of called' for the watch and for the fit at each acceptance."""
+def tally(rows: list[tuple]) -> str:
+    """'right of called' for the most-distal rule, the watch as deployed where the rows have it,
+    and the fit at each acceptance. A row: (truth, rule's joint, fit's joints[, watch's])."""
     called = [r for r in rows if r[1] is not None]
     cells = [f"{sum(r[1] == r[0] for r in called)} / {len(called)}"]
+    if called and len(called[0]) > 3:
+        cells.append(f"{sum(r[3] == r[0] for r in called)} / {len(called)}")
     cells += [f"{sum(r[2][a] == r[0] for r in called)} / {len(called)}" for a in ACCEPT]
     return " | ".join(cells)
 
@@ -148,23 +158,27 @@ def twin_part(rng: np.random.Generator) -> float:
             x = held(push, link)
             q, torque = push_torque(x, first, last)
             watch = watch_named(x, threshold, first, last)
+            deployed = watch_named(x, threshold, first, last, Placing(SURFACE, noise))
             named, fits = fit_named(q, torque, noise)
-            rows.append((joint, watch, named))
+            rows.append((joint, watch, named, deployed))
+            chi2 = " / ".join(f"{c:.1f}" for c in fits.chi2)
             lines.append((f"{link} ({schema.JOINT_NAMES[joint]})", np.linalg.norm(push[1]),
-                          watch, named, " / ".join(f"{f.chi2:.1f}" for f in fits)))  # fmt: skip
+                          watch, deployed, named, chi2))  # fmt: skip
     called = [r for r in rows if r[1] is not None]
     accept = max(ACCEPT, key=lambda a: (sum(r[2][a] == r[0] for r in called), -a))
     print("## 1. The twin pushed (truth known; selection)\n")
     print(f"Thresholds from its unpushed hold (N·m): {np.round(threshold, 2).tolist()}.\n")
-    print("| | watch | " + " | ".join(f"fit, accept {a:g}" for a in ACCEPT) + " |")
-    print("|---|---|" + "---|" * len(ACCEPT))
+    print("| | most distal joint loaded | watch as deployed | "
+          + " | ".join(f"fit, accept {a:g}" for a in ACCEPT) + " |")  # fmt: skip
+    print("|---|---|---|" + "---|" * len(ACCEPT))
     print(f"| named right, of the pushes the watch called | {tally(rows)} |\n")
-    print(f"Selected: accept {accept:g}. Push by push:\n")
-    print(f"| link pushed (its joint) | force N | watch names | fit names (accept {accept:g}) "
-          "| chi-square per link, base to flange |")  # fmt: skip
-    print("|---|---|---|---|---|")
-    for pushed, newtons, watch, named, chi2 in lines:
-        print(f"| {pushed} | {newtons:.0f} | {short(watch)} | {short(named[accept])} | {chi2} |")
+    print(f"Selected: accept {accept:g} (the watch places at {PLACE_ACCEPT:g}). Push by push:\n")
+    print("| link pushed (its joint) | force N | most distal joint loaded | watch as deployed "
+          f"| fit (accept {accept:g}) | chi-square per link, base to flange |")  # fmt: skip
+    print("|---|---|---|---|---|---|")
+    for pushed, newtons, watch, deployed, named, chi2 in lines:
+        print(f"| {pushed} | {newtons:.0f} | {short(watch)} | {short(deployed)} | "
+              f"{short(named[accept])} | {chi2} |")  # fmt: skip
     print()
     return accept
 
@@ -179,7 +193,7 @@ def kinematic_part(rng: np.random.Generator, poses: dict, noise: np.ndarray) -> 
         f"{KINEMATIC_PER_LINK} pushes per link and pose; the real arm's thresholds (N·m): "
         f"{np.round(threshold, 2).tolist()}; pushes no threshold calls are left out.\n"
     )
-    print("| pose | link's joint | called | watch right | "
+    print("| pose | link's joint | called | most distal joint loaded: right | "
           + " | ".join(f"fit right, accept {a:g}" for a in ACCEPT) + " |")  # fmt: skip
     print("|---|---|---|---|" + "---|" * len(ACCEPT))
     every = []
@@ -211,10 +225,12 @@ def kinematic_part(rng: np.random.Generator, poses: dict, noise: np.ndarray) -> 
 def real_part(logs: list[Path], noise: np.ndarray, accept: float) -> dict:
     print("## 2. The real pushes (no truth)\n")
     print(f"The fit at accept {accept:g}, chosen on part 1.\n")
-    print("| log | push at s | finder (most distal joint > 5 % of its rating) | watch names "
-          "| fit names | chi-square per link, base to flange | force N |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|")
+    print("| log | push at s | finder (most distal joint > 5 % of its rating) "
+          "| most distal joint over its threshold | watch as deployed "
+          "| fit | chi-square per link, base to flange | force N |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
     rated = rated_torque_nm(ARM)
+    placing = Placing(SURFACE, noise)
     poses = {}
     for log in logs:
         x = np.stack([s.x for s in log_samples(log)])
@@ -223,12 +239,13 @@ def real_part(logs: list[Path], noise: np.ndarray, accept: float) -> dict:
         for first, last in found:
             q, torque = push_torque(x, first, last)
             named, fits = fit_named(q, torque, noise)
-            best = next((f for f in fits if f.joint == short(named[accept])), None)
-            force = f"{np.linalg.norm(best.force_n):.0f}" if best else "-"
+            joint = named[accept]
+            force = "-" if joint is None else f"{np.linalg.norm(fits.force_n[joint]):.0f}"
             print(f"| {log.stem} | {first / TICK_HZ:.1f} | "
                   f"{schema.JOINT_NAMES[nearest_joint(off[first : last + 1], SHARE)]} | "
                   f"{short(watch_named(x, MARGIN * noise, first, last))} | "
-                  f"{short(named[accept])} | " + " / ".join(f"{f.chi2:.1f}" for f in fits)
+                  f"{short(watch_named(x, MARGIN * noise, first, last, placing))} | "
+                  f"{short(named[accept])} | " + " / ".join(f"{c:.1f}" for c in fits.chi2)
                   + f" | {force} |", flush=True)  # fmt: skip
     return poses
 

@@ -181,10 +181,11 @@ $PY -m robohealth_mj.commission model="$CRUISE42/best.ckpt" arm=ur10e healthy_ra
   out="$CRUISE42/commissioned_ownmotion_rate0.99"
 $PY experiments/real_arms/events.py --run cruise --suffix _ownmotion_rate0.99 --observability motion \
   > results/real_arms/events_contact.md
-# Which joint a push is at (2026-11-27, nineteenth session): the watch's joint (the most distal
-# joint loaded) against a force fit on the arm's kinematics (robohealth_mj/twin/contact_fit.py),
-# on the twin pushed where the truth is known, on kinematics alone at the real poses, and on the
-# real pushes (contact_where.md; about 2 minutes)
+# Which link a push is on (2026-11-27, nineteenth session): the most distal joint loaded (the
+# watch's name before), a force fit on the arm's kinematics (robohealth_mj/sim/contact_place.py)
+# and the watch as deployed now, which places its contacts with that fit: on the twin pushed
+# where the truth is known, on kinematics alone at the real poses, and on the real pushes
+# (contact_where.md; about 2 minutes). events_contact.md above is the watch as deployed.
 $PY experiments/real_arms/contact_where.py --run cruise > results/real_arms/contact_where.md
 # Today's twin (2026-11-27): the standard recipe at seed 42 recorded on the twin identified with
 # the estimator of 2026-11-27 (identified/twin.yaml), beside the same recipe on the twin of

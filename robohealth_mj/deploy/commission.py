@@ -94,7 +94,11 @@ def contact_record(rec: Recording, arm: str, sensing: str, margin: float | None)
     thresholds, how = commission_thresholds([r for r in runs if len(r)], arm, margin)
     if thresholds is None:
         return {"skipped": how}
-    return {"threshold_nm": [round(float(v), 4) for v in thresholds], "rule": how}
+    return {
+        "threshold_nm": [round(float(v), 4) for v in thresholds],
+        "rule": how,
+        "quiet_nm": [round(float(v), 4) for v in thresholds / margin],  # placing's noise
+    }
 
 
 def arm_placement(graph: GraphSpec, placement: dict | None) -> np.ndarray:

@@ -36,7 +36,9 @@ from robohealth_mj.learn.checkpoint import (
 )
 from robohealth_mj.models.incremental import PooledHead, SnapshotStep, supports_incremental
 from robohealth_mj.models.onnx import ExportWrapper, export_module, export_onnx, onnx_parity
+from robohealth_mj.runtime.contact import Placing
 from robohealth_mj.runtime.metadata import read_metadata  # noqa: F401 (re-exported)
+from robohealth_mj.sim.contact_surface import arm_surface
 
 PARITY_TOLERANCE = 1e-4
 
@@ -288,15 +290,22 @@ def export_checkpoint(
 
 def commissioning_metadata(ckpt: dict[str, Any]) -> dict[str, str]:
     """What a commissioned model was commissioned on (nothing for one that was not), and the
-    contact watch's thresholds where commissioning fitted them."""
+    contact watch's thresholds and what places a contact on a link, where commissioning fitted
+    them."""
     record = ckpt.get("commissioning")
     if not record:
         return {}
-    contact = (record.get("contact") or {}).get("threshold_nm")
+    contact = record.get("contact") or {}
+    threshold, quiet = contact.get("threshold_nm"), contact.get("quiet_nm")
+    placing = {}
+    if threshold and quiet and record.get("arm"):  # commissioned before 2026-11-27: no quiet_nm
+        surface = Placing(arm_surface(record["arm"]), np.asarray(quiet))
+        placing = {"contact_placing": json.dumps(surface.to_dict())}
     return {
         "commissioning_data_fingerprint": record["healthy_fingerprint"],
         "commissioning_healthy_minutes": str(record["healthy_minutes"]),
-        **({"contact_threshold_nm": json.dumps(contact)} if contact else {}),
+        **({"contact_threshold_nm": json.dumps(threshold)} if threshold else {}),
+        **placing,
     }
 
 

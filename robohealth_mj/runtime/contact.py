@@ -21,7 +21,12 @@ Per stream, per tick (vectorised over streams, no torch):
   With ``exclude_contact`` the ticks over a threshold are left out of it (a long push does not
   become its own level), until every tick of the span was: what lasts that long is a new rest.
 - *Contact*: a joint's residual more than its threshold off the level for ``confirm`` ticks in a
-  row; the joint named is the most distal joint over its threshold.
+  row. The joint named: where the model carries the arm's chain and surface, the link a single
+  push explains (:func:`robohealth_mj.sim.contact_place.place`: a push square on a joint's round
+  housing does not load that joint, so the most distal joint loaded can fall short of it),
+  placed when the contact is confirmed and again whenever its torques have grown half as large
+  again; otherwise, or where no single push explains them, the most distal joint over its
+  threshold.
 
 The thresholds are the arm's, in N·m: commissioning replays its healthy running through the same
 watch and takes ``margin`` times each joint's largest quiet deviation
@@ -35,12 +40,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.sim.contact_place import ArmSurface, place
 from robohealth_mj.sim.ratings import rated_torque_nm
 
+_POS = schema.feature_index("pos")
 _VEL = schema.feature_index("vel")
 _EFFORT = schema.feature_index("effort")
 _RESIDUAL = schema.feature_index("effort_residual")
 J = schema.N_JOINTS
+REPLACE_GROWTH = 1.5  # a contact is placed again when its torques have grown this much
 
 
 @dataclass(frozen=True)
@@ -70,14 +78,36 @@ class ContactPolicy:
             raise ValueError("contact still_rad_s and command_share must be positive")
 
 
+@dataclass(frozen=True)
+class Placing:
+    """What places a contact on a link: the arm's chain and surface, and each joint's noise
+    (N·m; its largest quiet deviation on the healthy running), the chi-square's unit."""
+
+    surface: ArmSurface
+    noise_nm: np.ndarray
+
+    def to_dict(self) -> dict:
+        return {"surface": self.surface.to_dict(), "noise_nm": np.round(self.noise_nm, 4).tolist()}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Placing:
+        return cls(ArmSurface.from_dict(d["surface"]), np.asarray(d["noise_nm"], np.float64))
+
+
 class ContactBank:
     """The watch's state for every stream slot: a ring of recent residuals, the quiet's length
-    and its model torque, the run of ticks over threshold."""
+    and its model torque, the run of ticks over threshold, the contact's placement."""
 
     def __init__(
-        self, policy: ContactPolicy, threshold_nm: np.ndarray, arm: str, capacity: int
+        self,
+        policy: ContactPolicy,
+        threshold_nm: np.ndarray,
+        arm: str,
+        capacity: int,
+        placing: Placing | None = None,
     ) -> None:
         self.policy = policy
+        self.placing = placing
         self.threshold = np.asarray(threshold_nm, np.float64).reshape(J)
         self.command_nm = policy.command_share * rated_torque_nm(arm)
         self.ring = np.zeros((capacity, policy.level_ticks, J), np.float32)
@@ -86,9 +116,11 @@ class ContactBank:
         self.quiet = np.zeros(capacity, np.int64)  # length of the current quiet
         self.held = np.zeros((capacity, J), np.float32)  # model torque when the quiet began
         self.over = np.zeros(capacity, np.int64)  # ticks over threshold in a row
+        self.placed = np.full(capacity, -1, np.int64)  # the link the contact was placed on
+        self.placed_size = np.zeros(capacity)  # the size of the torques it was placed with
 
     def ensure(self, capacity: int) -> None:
-        for name in ("ring", "skip", "written", "quiet", "held", "over"):
+        for name in ("ring", "skip", "written", "quiet", "held", "over", "placed", "placed_size"):
             old = getattr(self, name)
             if capacity > len(old):
                 new = np.zeros((capacity, *old.shape[1:]), old.dtype)
@@ -98,10 +130,16 @@ class ContactBank:
     def reset(self, slots: np.ndarray) -> None:
         """Forget these slots (a new stream, or a gap in one)."""
         self.written[slots], self.quiet[slots], self.over[slots] = 0, 0, 0
+        self.placed[slots] = -1
 
     def deviation(self, slots: np.ndarray, x: np.ndarray) -> np.ndarray:
-        """One raw snapshot per slot (distinct) ``x [B, 12, F]`` -> each joint's residual off its
-        level ``[B, J]`` in N·m, NaN where the stream is not watched (moving, or not settled)."""
+        """One raw snapshot per slot (distinct) ``x [B, 12, F]`` -> how far each joint's residual
+        is off its level ``[B, J]`` in N·m, NaN where the stream is not watched (moving, or not
+        settled)."""
+        return np.abs(self.offset(slots, x))
+
+    def offset(self, slots: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """As :meth:`deviation`, with its sign: each joint's residual minus its level."""
         p = self.policy
         vel, residual = x[:, :J, _VEL], x[:, :J, _RESIDUAL]
         model = x[:, :J, _EFFORT] - residual
@@ -130,19 +168,43 @@ class ContactBank:
         skipped = self.skip.reshape(-1)[flat] & p.exclude_contact
         left_out = before | (skipped & ~(before | skipped).all(axis=1, keepdims=True))
         past[left_out] = np.nan
-        off[watched] = np.abs(residual[watched] - _median(past).astype(np.float64))
+        off[watched] = residual[watched] - _median(past).astype(np.float64)
         return off
 
     def update(self, slots: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """One tick per slot -> ``(contact [B] bool, joint named [B], -1 when none)``."""
-        over = np.nan_to_num(self.deviation(slots, x), nan=0.0) > self.threshold  # [B, J]
+        off = np.nan_to_num(self.offset(slots, x), nan=0.0)
+        over = np.abs(off) > self.threshold  # [B, J]
         hit = over.any(axis=1)
         self.skip[slots, (self.written[slots] - 1) % self.policy.level_ticks] = hit
         run = np.where(hit, self.over[slots] + 1, 0)
         self.over[slots] = run
         contact = run >= self.policy.confirm
         distal = J - 1 - np.argmax(over[:, ::-1], axis=1)
-        return contact, np.where(contact, distal, -1)
+        named = np.where(contact, distal, -1)
+        if self.placing is not None:
+            named = self._place(slots, x, off, contact, named)
+        return contact, named
+
+    def _place(
+        self, slots: np.ndarray, x: np.ndarray, off: np.ndarray, contact: np.ndarray,
+        distal: np.ndarray,
+    ) -> np.ndarray:  # fmt: skip
+        """The joints named where contacts are placed on links: placed on confirmation, and
+        again once the torques have grown by ``REPLACE_GROWTH``; the most distal joint over its
+        threshold where no single push explains them."""
+        p = self.placing
+        size = np.linalg.norm(off / p.noise_nm, axis=1)
+        self.placed[slots[~contact]] = -1
+        again = contact & (
+            (self.over[slots] == self.policy.confirm)
+            | (size >= REPLACE_GROWTH * self.placed_size[slots])
+        )
+        for b in np.flatnonzero(again):  # rare: a contact's first tick, or a growing one
+            where = place(p.surface, x[b, :J, _POS], -off[b], p.noise_nm)
+            self.placed[slots[b]], self.placed_size[slots[b]] = where.joint, size[b]
+        placed = self.placed[slots]
+        return np.where(contact & (placed >= 0), placed, distal)
 
 
 def _median(values: np.ndarray) -> np.ndarray:

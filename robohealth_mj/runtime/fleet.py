@@ -36,7 +36,7 @@ from robohealth_mj.common.numeric import joint_scores_from_logits, softmax
 from robohealth_mj.data.observability import MOVING_RAD_S, check_observability, hide_unobservable
 from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
-from robohealth_mj.runtime.contact import ContactBank, ContactPolicy
+from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, Placing
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
 from robohealth_mj.runtime.phases import NO_CLOCK, NoClock
@@ -266,8 +266,13 @@ class FleetRuntime:
             self.mode = "windowed"
         self.model_id = meta["model_id"]
         if "contact_threshold_nm" in meta and self.contact_policy.enabled:
+            placing = meta.get("contact_placing")  # models commissioned before 2026-11-27: none
             self.contact = ContactBank(
-                self.contact_policy, json.loads(meta["contact_threshold_nm"]), self.arm, capacity
+                self.contact_policy,
+                json.loads(meta["contact_threshold_nm"]),
+                self.arm,
+                capacity,
+                Placing.from_dict(json.loads(placing)) if placing else None,
             )
 
     # streams

@@ -257,7 +257,12 @@ def test_commissioning_fits_the_contact_watch_and_the_monitor_calls_a_push_with_
     record = commission(ckpt, str(tmp_path / "hold"), tmp_path / "c", reference)
     thresholds = record["contact"]["threshold_nm"]
     assert len(thresholds) == J and min(thresholds) > 0
-    assert json.loads(read_metadata(record["onnx"])["contact_threshold_nm"]) == thresholds
+    meta = read_metadata(record["onnx"])
+    assert json.loads(meta["contact_threshold_nm"]) == thresholds
+    placing = json.loads(meta["contact_placing"])  # the arm's surface and the fit's noise
+    assert np.allclose(np.array(placing["noise_nm"]) * 2.0, thresholds, rtol=1e-3)
+    assert len(placing["surface"]["link"]) == len(placing["surface"]["point"]) > 1000
+    assert len(json.dumps(record["contact"])) < 500  # the record stays readable: no surface
 
     def contacts(data: Path, **kwargs) -> list:
         runtime = ModelRuntime(record["onnx"], **kwargs)

@@ -12,7 +12,13 @@ from robohealth_mj import schema
 from robohealth_mj.common.config import compose_config
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.recording.recorder import build_simulator, chunk_features
-from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, commission_thresholds
+from robohealth_mj.runtime.contact import (
+    ContactBank,
+    ContactPolicy,
+    Placing,
+    commission_thresholds,
+)
+from robohealth_mj.sim.contact_surface import arm_surface
 from robohealth_mj.sim.pushes import nearest_joint, read_pushes
 
 J = schema.N_JOINTS
@@ -140,6 +146,35 @@ def test_bench_contact_times_a_resting_fleet_per_stream_count(capsys):
     from robohealth_mj.bench import main as bench_main
 
     bench_main(["contact", "--streams", "3", "20"])
-    rows = [line for line in capsys.readouterr().out.splitlines() if line[2:3].isdigit()]
+    out = capsys.readouterr().out.splitlines()
+    rows = [line for line in out if line[2:3].isdigit()]
     assert [row.split(" | ")[0] for row in rows] == ["| 3", "| 20"]
     assert all(float(row.split(" | ")[1]) > 0 for row in rows)
+    placing = [line for line in out if line.startswith("| one placement")]
+    assert len(placing) == 1 and float(placing[0].split(" | ")[1]) > 0
+
+
+def test_a_push_square_on_the_flange_is_placed_there_where_the_model_carries_the_surface():
+    """The flange pushed square on its side: wrist 3 is not loaded, so the most distal joint over
+    its threshold is wrist 2; with the arm's chain and surface the watch names wrist 3."""
+    surface = arm_surface("ur10e")
+    pose = np.array([-0.28, -1.95, -1.67, -1.53, 0.99, 0.39])
+    lever, normal = surface.lever(pose)
+    point = np.flatnonzero(surface.link == 5)[3]  # the flange's side, through wrist 3's axis
+    external = lever[point] @ (-40.0 * normal[point])  # N·m: 40 N square on
+    assert abs(external[5]) < 1e-9
+    x = _still(200)
+    x[:, :J, schema.feature_index("pos")] = pose
+    x[100:116, :J, RESIDUAL] -= external  # the drives hold against the push (0.8 s)
+    x[100:116, :J, EFFORT] -= external
+    noise = np.array([5.8, 10.2, 1.7, 0.56, 0.71, 2.0])
+    threshold = 2.0 * noise
+    plain = ContactBank(ContactPolicy(), threshold, "ur10e", 1)
+    placing = ContactBank(ContactPolicy(), threshold, "ur10e", 1, Placing(surface, noise))
+    slot = np.zeros(1, np.int64)
+    named = {
+        "plain": [int(plain.update(slot, t[None])[1][0]) for t in x],
+        "placed": [int(placing.update(slot, t[None])[1][0]) for t in x],
+    }
+    assert set(named["plain"][103:116]) == {4} and set(named["placed"][103:116]) == {5}
+    assert all(j < 0 for j in named["placed"][:103] + named["placed"][116:])
