@@ -13,8 +13,8 @@ scored by chi-square in units of each joint's noise; the link named is the most 
 whose best point explains the torques to within ``accept``.
 
 numpy only: the streaming runtime runs it (:mod:`robohealth_mj.runtime.contact`). The arm's
-chain and surface (:class:`ArmSurface`) come from its MuJoCo model at commissioning
-(:func:`robohealth_mj.sim.contact_surface.arm_surface`) and travel in the exported model.
+chain and surface (:class:`ArmSurface`) come from its MuJoCo model when a commissioned model is
+exported (:func:`robohealth_mj.sim.contact_surface.arm_surface`) and travel in that model.
 """
 
 from __future__ import annotations
