@@ -1,14 +1,14 @@
-"""Where a push was: the joint the contact watch names against a force fit on the arm's
-kinematics (:mod:`robohealth_mj.sim.contact_place`), where the truth is known and on the real
-pushes, where it is not.
+"""Where a push was: the most distal joint loaded against a force fit on the arm's kinematics
+(:mod:`robohealth_mj.sim.contact_place`) and the contact watch as deployed, which places its
+contacts with that fit; where the truth is known and on the real pushes, where it is not.
 
     python experiments/real_arms/contact_where.py [--run cruise]
         > results/real_arms/contact_where.md
 
-The watch, and the hindsight finder the real pushes were scored against (``events.py``), both
-name the most distal joint a push loads. A hand pressing square on a joint's round housing
-pushes through that joint's axis and loads it not at all, so that rule can name a joint short of
-the push. Three parts, each with the watch's rule beside the fit's:
+The watch before 2026-11-27, and the hindsight finder the real pushes were scored against
+(``events.py``), both name the most distal joint a push loads. A hand pressing square on a
+joint's round housing pushes through that joint's axis and loads it not at all, so that rule can
+name a joint short of the push. Three parts, each with that rule beside the fit's:
 
 1. The twin, simulated (selection): it holds a pose and is pushed for 1 s at points drawn on
    each link's collision surface (a geom by its area), with a force drawn uniformly inside the
