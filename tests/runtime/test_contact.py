@@ -178,3 +178,17 @@ def test_a_push_square_on_the_flange_is_placed_there_where_the_model_carries_the
     }
     assert set(named["plain"][103:116]) == {4} and set(named["placed"][103:116]) == {5}
     assert all(j < 0 for j in named["placed"][:103] + named["placed"][116:])
+
+
+def test_a_contact_no_single_push_explains_keeps_the_most_distal_joint_over_its_threshold():
+    """Wrist 2 alone kicked, nothing upstream: no push on any link gives that, so the watch names
+    the most distal joint over its threshold rather than nothing."""
+    surface = arm_surface("ur10e")
+    noise = np.array([5.8, 10.2, 1.7, 0.56, 0.71, 2.0])
+    x = _still(200)
+    x[:, :J, schema.feature_index("pos")] = [-0.28, -1.95, -1.67, -1.53, 0.99, 0.39]
+    x = _push(x, slice(100, 116), [4], nm=30.0)
+    bank = ContactBank(ContactPolicy(), 2.0 * noise, "ur10e", 1, Placing(surface, noise))
+    slot = np.zeros(1, np.int64)
+    named = [int(bank.update(slot, t[None])[1][0]) for t in x]
+    assert set(named[103:116]) == {4}
