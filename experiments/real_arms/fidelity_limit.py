@@ -32,7 +32,7 @@ from unittest import mock
 
 import numpy as np
 import yaml
-from scipy.signal import butter, filtfilt, sosfiltfilt
+from scipy.signal import butter, filtfilt
 
 from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.twin import identify as twin_identify
@@ -105,10 +105,8 @@ def on_grid(log: JointLog, x: np.ndarray, hz: float) -> tuple[np.ndarray, np.nda
 def up_to_cutoff(log: JointLog, cutoff_hz: float) -> np.ndarray:
     """``[T, 6]`` the target moment's content up to the cutoff: its zero-phase low-pass on the
     uniform grid the twin's acceleration is estimated on, read back at the rows."""
-    hz = twin_identify.UNIFORM_HZ
-    grid, moment = on_grid(log, log.model_torque, hz)
-    smooth = sosfiltfilt(butter(2, cutoff_hz, fs=hz, output="sos"), moment, axis=0)
-    return np.stack([np.interp(log.t, grid, smooth[:, j]) for j in range(smooth.shape[1])], 1)
+    grid, moment = twin_identify.on_uniform_grid(log.t, log.model_torque)
+    return twin_identify.at_rows(log.t, grid, twin_identify.low_pass(moment, cutoff_hz))
 
 
 def nrmse_of_range(x: np.ndarray, y: np.ndarray, log: JointLog) -> np.ndarray:

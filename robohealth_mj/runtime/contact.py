@@ -193,16 +193,18 @@ class ContactBank:
         """The joints named where contacts are placed on links: placed on confirmation, and
         again once the torques have grown by ``REPLACE_GROWTH``; the most distal joint over its
         threshold where no single push explains them."""
-        p = self.placing
-        size = np.linalg.norm(off / p.noise_nm, axis=1)
         self.placed[slots[~contact]] = -1
-        again = contact & (
-            (self.over[slots] == self.policy.confirm)
-            | (size >= REPLACE_GROWTH * self.placed_size[slots])
+        on = np.flatnonzero(contact)
+        if not len(on):  # the usual tick: nothing to place
+            return distal
+        p = self.placing
+        size = np.linalg.norm(off[on] / p.noise_nm, axis=1)
+        again = (self.over[slots[on]] == self.policy.confirm) | (
+            size >= REPLACE_GROWTH * self.placed_size[slots[on]]
         )
-        for b in np.flatnonzero(again):  # rare: a contact's first tick, or a growing one
-            where = place(p.surface, x[b, :J, _POS], -off[b], p.noise_nm)
-            self.placed[slots[b]], self.placed_size[slots[b]] = where.joint, size[b]
+        for b, grown in zip(on[again], size[again], strict=True):  # a contact's first tick, or
+            where = place(p.surface, x[b, :J, _POS], -off[b], p.noise_nm)  # a growing one
+            self.placed[slots[b]], self.placed_size[slots[b]] = where.joint, grown
         placed = self.placed[slots]
         return np.where(contact & (placed >= 0), placed, distal)
 

@@ -59,18 +59,29 @@ def motion(log: JointLog, cutoff_hz: float) -> Motion:
     third of the steps are 12 ms, not 10), and a filter that takes them as evenly spaced bends the
     acceleration; so the velocity is interpolated onto a uniform grid, filtered and
     differentiated there, and read back at the rows."""
-    cutoff = min(float(cutoff_hz), 0.4 * log.rate_hz)
-    grid = np.arange(log.t[0], log.t[-1] + 0.5 / UNIFORM_HZ, 1.0 / UNIFORM_HZ)
-    qd = np.stack([np.interp(grid, log.t, log.qd[:, j]) for j in range(log.qd.shape[1])], axis=1)
-    if len(grid) > 15:
-        qd = sosfiltfilt(butter(2, cutoff, fs=UNIFORM_HZ, output="sos"), qd, axis=0)
-    qdd = np.gradient(qd, grid, axis=0)
+    grid, qd = on_uniform_grid(log.t, log.qd)
+    qd = low_pass(qd, min(float(cutoff_hz), 0.4 * log.rate_hz))
+    qd_rows = at_rows(log.t, grid, qd)
+    qdd = at_rows(log.t, grid, np.gradient(qd, grid, axis=0))
+    return Motion(log.q, qd_rows, qdd, np.tanh(qd_rows / SIGN_VELOCITY))
 
-    def at_rows(x: np.ndarray) -> np.ndarray:
-        return np.stack([np.interp(log.t, grid, x[:, j]) for j in range(x.shape[1])], axis=1)
 
-    qd_rows = at_rows(qd)
-    return Motion(log.q, qd_rows, at_rows(qdd), np.tanh(qd_rows / SIGN_VELOCITY))
+def on_uniform_grid(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``x [T, C]`` logged at times ``t`` interpolated onto a grid at UNIFORM_HZ: (grid, values)."""
+    grid = np.arange(t[0], t[-1] + 0.5 / UNIFORM_HZ, 1.0 / UNIFORM_HZ)
+    return grid, np.stack([np.interp(grid, t, x[:, c]) for c in range(x.shape[1])], axis=1)
+
+
+def low_pass(x: np.ndarray, cutoff_hz: float) -> np.ndarray:
+    """``x`` on the uniform grid, low-passed without phase lag (left as it is when too short)."""
+    if len(x) <= 15:
+        return x
+    return sosfiltfilt(butter(2, cutoff_hz, fs=UNIFORM_HZ, output="sos"), x, axis=0)
+
+
+def at_rows(t: np.ndarray, grid: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``x`` on the uniform grid read back at the log's times ``t``."""
+    return np.stack([np.interp(t, grid, x[:, c]) for c in range(x.shape[1])], axis=1)
 
 
 def rigid_torques(arm: str, m: Motion, payload_kg: float = 0.0) -> np.ndarray:
@@ -231,9 +242,19 @@ def choose_cutoff(arm: str, logs: Sequence[JointLog]) -> tuple[float, dict[float
     each log in turn is held out (a single log: its two halves), the rest fitted, and the
     held-out error averaged (a fold whose other logs leave a joint still is not scored).
     Returns the cutoff and the mean error per cutoff tried."""
+    cutoff, scores, _ = _choose_cutoff(arm, logs)
+    return cutoff, scores
+
+
+def _choose_cutoff(
+    arm: str, logs: Sequence[JointLog]
+) -> tuple[float, dict[float, float], list[_Prepared] | None]:
+    """:func:`choose_cutoff`, and the logs prepared at the chosen cutoff where the folds are the
+    logs themselves (two or more), for the fit to reuse."""
     folds = list(logs) if len(logs) >= 2 else _halves(logs[0])
     highest = 0.4 * min(log.rate_hz for log in folds)
-    scores = {}
+    scores: dict[float, float] = {}
+    best, best_prepared = None, None
     for cutoff in (c for c in CUTOFF_GRID_HZ if c <= highest):
         prepared = _prepare(arm, folds, cutoff)
         errors = []
@@ -242,11 +263,13 @@ def choose_cutoff(arm: str, logs: Sequence[JointLog]) -> tuple[float, dict[float
                 errors.append(_held_out_error(held_out, _fit(prepared[:k] + prepared[k + 1 :])))
         if errors:
             scores[cutoff] = float(np.mean(errors))
-    if not scores:
+            if best is None or scores[cutoff] < scores[best]:  # ties: the lower cutoff
+                best, best_prepared = cutoff, prepared
+    if best is None:
         raise InputError("identify: cutoff_hz=auto found nothing to score it on (every joint "
                          "must move in the fit logs without any one of them, logged at 7.5 Hz or "
                          "more); pass cutoff_hz=")  # fmt: skip
-    return min(scores, key=scores.__getitem__), scores
+    return best, scores, best_prepared if len(logs) >= 2 else None
 
 
 def _all_joints_move(prepared: Sequence[_Prepared]) -> bool:
@@ -260,10 +283,10 @@ def identify(arm: str, logs: Sequence[JointLog], cutoff_hz: float | None = None)
     (None: chosen by :func:`choose_cutoff`)."""
     if not logs:
         raise InputError("identify: no log to fit on")
-    scores = None
+    scores = prepared = None
     if cutoff_hz is None:
-        cutoff_hz, scores = choose_cutoff(arm, logs)
-    drives = _fit(_prepare(arm, logs, cutoff_hz))
+        cutoff_hz, scores, prepared = _choose_cutoff(arm, logs)
+    drives = _fit(prepared or _prepare(arm, logs, cutoff_hz))
     with_model = all(log.model_torque is not None for log in logs)
     notes = [] if with_model else ["no model torque in the logs: rotor inertia fitted on current"]
     noise = effort_noise(logs, drives.torque_constant)
