@@ -50,3 +50,17 @@ for dev in cuda cpu; do
     data.evaluate.heldout=outputs/learnable/heldout data.evaluate.probe=null \
     out_dir=outputs/train_$dev
 done > results/fleet/cuda/train_cuda_check.txt
+# 2026-11-27, on a lent machine (one NVIDIA H200; torch 2.11.0+cu130, torch-geometric 2.8.0.post1):
+# the paths added since the check above (train labels=visible, evaluate observability=motion) on
+# CUDA and on the CPU, for stgnn_fixed and anomaly_residual, on the same learnable corpus (recorded
+# here as above, into outputs/learnable). The CPU rows equal those of a 2-core machine to the digit.
+for dev in cuda cpu; do
+  for variant in stgnn_fixed anomaly_residual; do
+    $PY -m robohealth_mj.train variant=$variant seed=42 window=8 trainer.device=$dev \
+      trainer.epochs=3 trainer.progress=false labels=visible 'data.train=[outputs/learnable/train_*]' \
+      data.evaluate.heldout=outputs/learnable/heldout data.evaluate.probe=null \
+      out_dir=outputs/visible_${variant}_$dev
+    $PY -m robohealth_mj.evaluate ckpt=outputs/visible_${variant}_$dev/best.ckpt \
+      data=outputs/learnable/heldout observability=motion device=$dev
+  done
+done > results/fleet/cuda/train_visible_motion_check.txt
