@@ -54,6 +54,7 @@ done > results/fleet/cuda/train_cuda_check.txt
 # the paths added since the check above (train labels=visible, evaluate observability=motion) on
 # CUDA and on the CPU, for stgnn_fixed and anomaly_residual, on the same learnable corpus (recorded
 # here as above, into outputs/learnable). The CPU rows equal those of a 2-core machine to the digit.
+# (As run, the out_dir was /tmp/cc_<variant>_<device> and each step's exit status was printed.)
 for dev in cuda cpu; do
   for variant in stgnn_fixed anomaly_residual; do
     $PY -m robohealth_mj.train variant=$variant seed=42 window=8 trainer.device=$dev \
