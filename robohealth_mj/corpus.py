@@ -29,6 +29,7 @@ import hydra
 from hydra.utils import instantiate
 from omegaconf import DictConfig
 
+from robohealth_mj.common.config import run_hydra_app
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.resources import HYDRA_CONF
 from robohealth_mj.recording.corpus import CORPUS_INDEX, build_corpus
@@ -51,4 +52,4 @@ def main(cfg: DictConfig) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run_hydra_app("corpus", main)

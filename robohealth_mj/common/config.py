@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import os
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from hydra import compose, initialize_config_dir
 from hydra.core.global_hydra import GlobalHydra
+from hydra.errors import ConfigCompositionException, OverrideParseException
 from omegaconf import DictConfig, OmegaConf
 
 from robohealth_mj.common.errors import InputError, report
@@ -69,3 +71,34 @@ def load_cli_config(
                 "a colon, e.g. key='\"{arm}_\"'"
             ))) from None  # fmt: skip
     return OmegaConf.merge(cfg, *given)
+
+
+def run_hydra_app(prog: str, app: Callable[[], Any]) -> None:
+    """Run a ``@hydra.main`` entry point so that an override Hydra cannot apply (a key the config
+    lacks, a config group option that does not exist, a value it cannot parse) is one line and
+    exit status 2, as every other user error is: Hydra's own report of it is several lines and
+    exit status 1. Hydra raises instead of reporting only under ``HYDRA_FULL_ERROR``, which is
+    set for the call (a bug inside the app then keeps its whole traceback)."""
+    before = os.environ.get("HYDRA_FULL_ERROR")
+    os.environ["HYDRA_FULL_ERROR"] = "1"
+    try:
+        app()
+    except (ConfigCompositionException, OverrideParseException) as exc:
+        raise SystemExit(report(prog, InputError(_one_line(exc)))) from None
+    finally:
+        if before is None:
+            os.environ.pop("HYDRA_FULL_ERROR", None)
+        else:
+            os.environ["HYDRA_FULL_ERROR"] = before
+
+
+def _one_line(exc: BaseException) -> str:
+    """Hydra's message on one line: the override it could not parse first, the reason it gives
+    (OmegaConf's, behind it) after, without the key dump and the config search path."""
+    text = str(exc).split("Config search path:")[0]
+    if exc.__cause__ is not None:
+        text += f" ({str(exc.__cause__).splitlines()[0]})"
+    lines = (line.strip() for line in text.splitlines())
+    kept = [line for line in lines if line and not line.startswith(("full_key:", "object_type="))]
+    override = getattr(exc, "override", None)
+    return " ".join([f"{override}:"] * bool(override) + kept)
