@@ -172,6 +172,14 @@ def twin_part(rng: np.random.Generator) -> float:
           + " | ".join(f"fit, accept {a:g}" for a in ACCEPT) + " |")  # fmt: skip
     print("|---|---|---|" + "---|" * len(ACCEPT))
     print(f"| named right, of the pushes the watch called | {tally(rows)} |\n")
+    # determined by the torques: the pushed link explains them within the quiet wander and no
+    # link before it does (what the fit at PLACE_ACCEPT names right, by its definition)
+    determined = [r for r in called if r[2][PLACE_ACCEPT] == r[0]]
+    print(f"Determined by the torques (the pushed link explains them within the quiet wander, "
+          f"chi-square <= {PLACE_ACCEPT:g}, and no link before it does): {len(determined)} of the "
+          f"{len(called)} called. Of those, the watch as deployed names "
+          f"{sum(r[3] == r[0] for r in determined)} right, the most distal joint loaded "
+          f"{sum(r[1] == r[0] for r in determined)}.\n")  # fmt: skip
     print(f"Selected: accept {accept:g} (the watch places at {PLACE_ACCEPT:g}). Push by push:\n")
     print("| link pushed (its joint) | force N | most distal joint loaded | watch as deployed "
           f"| fit (accept {accept:g}) | chi-square per link, base to flange |")  # fmt: skip
