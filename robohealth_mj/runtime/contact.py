@@ -35,11 +35,13 @@ watch and takes ``margin`` times each joint's largest quiet deviation
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.sim.contact_place import ArmSurface, place
 from robohealth_mj.sim.ratings import rated_torque_nm
 
@@ -89,9 +91,31 @@ class Placing:
     def to_dict(self) -> dict:
         return {"surface": self.surface.to_dict(), "noise_nm": np.round(self.noise_nm, 4).tolist()}
 
+    def __post_init__(self) -> None:
+        if self.noise_nm.shape != (len(self.surface.axis),) or not (self.noise_nm > 0).all():
+            raise ValueError(f"noise_nm must be one positive value per joint, got {self.noise_nm}")
+
     @classmethod
     def from_dict(cls, d: dict) -> Placing:
         return cls(ArmSurface.from_dict(d["surface"]), np.asarray(d["noise_nm"], np.float64))
+
+
+def contact_metadata(meta: dict, source: str) -> tuple[np.ndarray, Placing | None] | None:
+    """The thresholds ``[J]`` and placing an exported model carries (None: no contact watch;
+    the placing None for models commissioned before 2026-11-27); an :class:`InputError` naming
+    ``source`` and the key for a value that cannot be read, before any stream is watched."""
+    if "contact_threshold_nm" not in meta:
+        return None
+    key = "contact_threshold_nm"
+    try:
+        threshold = np.asarray(json.loads(meta[key]), np.float64)
+        if threshold.shape != (J,) or not (threshold > 0).all():
+            raise ValueError(f"expected {J} positive values, got {threshold.tolist()}")
+        key = "contact_placing"
+        placing = Placing.from_dict(json.loads(meta[key])) if meta.get(key) else None
+    except (ValueError, KeyError, TypeError) as exc:  # JSON's decode error is a ValueError
+        raise InputError(f"{source}: metadata '{key}' cannot be read: {exc}") from None
+    return threshold, placing
 
 
 class ContactBank:
@@ -123,7 +147,7 @@ class ContactBank:
         for name in ("ring", "skip", "written", "quiet", "held", "over", "placed", "placed_size"):
             old = getattr(self, name)
             if capacity > len(old):
-                new = np.zeros((capacity, *old.shape[1:]), old.dtype)
+                new = np.full((capacity, *old.shape[1:]), -1 if name == "placed" else 0, old.dtype)
                 new[: len(old)] = old
                 setattr(self, name, new)
 

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import base64
 import gc
-import json
 import logging
 import time
 from collections.abc import Sequence
@@ -36,7 +35,7 @@ from robohealth_mj.common.numeric import joint_scores_from_logits, softmax
 from robohealth_mj.data.observability import MOVING_RAD_S, check_observability, hide_unobservable
 from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
-from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, Placing
+from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, contact_metadata
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
 from robohealth_mj.runtime.phases import NO_CLOCK, NoClock
@@ -265,15 +264,10 @@ class FleetRuntime:
             )
             self.mode = "windowed"
         self.model_id = meta["model_id"]
-        if "contact_threshold_nm" in meta and self.contact_policy.enabled:
-            placing = meta.get("contact_placing")  # models commissioned before 2026-11-27: none
-            self.contact = ContactBank(
-                self.contact_policy,
-                json.loads(meta["contact_threshold_nm"]),
-                self.arm,
-                capacity,
-                Placing.from_dict(json.loads(placing)) if placing else None,
-            )
+        watch = contact_metadata(meta, str(path))
+        if watch is not None and self.contact_policy.enabled:
+            threshold, placing = watch
+            self.contact = ContactBank(self.contact_policy, threshold, self.arm, capacity, placing)
 
     # streams
 

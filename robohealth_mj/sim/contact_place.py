@@ -51,6 +51,18 @@ class ArmSurface:
     def to_dict(self) -> dict[str, list]:
         return {k: np.round(v, 6).tolist() for k, v in self.__dict__.items()}
 
+    def __post_init__(self) -> None:
+        """A surface that does not fit its chain would fail mid-stream, at a contact: say so
+        when it is built."""
+        j, p = len(self.offset_pos), len(self.link)
+        shapes = {"offset_pos": (j, 3), "offset_rot": (j, 3, 3), "anchor": (j, 3),
+                  "axis": (j, 3), "point": (p, 3), "normal": (p, 3)}  # fmt: skip
+        for name, shape in shapes.items():
+            if getattr(self, name).shape != shape:
+                raise ValueError(f"{name} has shape {getattr(self, name).shape}, expected {shape}")
+        if self.link.ndim != 1 or not p or self.link.min() < 0 or self.link.max() >= j:
+            raise ValueError(f"link must name joints 0..{j - 1} for each surface point")
+
     @classmethod
     def from_dict(cls, d: dict[str, list]) -> ArmSurface:
         return cls(**{k: np.asarray(d[k], np.int64 if k == "link" else np.float64)

@@ -3,6 +3,7 @@ nearest it, and nothing else is: not a commanded move, not the rest after a push
 
 from __future__ import annotations
 
+import json
 from collections import Counter
 
 import numpy as np
@@ -17,6 +18,7 @@ from robohealth_mj.runtime.contact import (
     ContactPolicy,
     Placing,
     commission_thresholds,
+    contact_metadata,
 )
 from robohealth_mj.sim.contact_surface import arm_surface
 from robohealth_mj.sim.pushes import nearest_joint, read_pushes
@@ -140,6 +142,29 @@ def test_contact_policy_and_pushes_refuse_nonsense_in_one_line():
             InputError, match=r"session\.pushes\[0\]: .*" + said.replace("[", r"\[")
         ):
             read_pushes([entry], model)
+
+
+def test_a_model_s_contact_metadata_is_read_or_refused_in_one_line_naming_the_key():
+    surface = arm_surface("ur10e")
+    placing = Placing(surface, np.full(J, 0.5))
+    good = {"contact_threshold_nm": json.dumps([1.0] * J),
+            "contact_placing": json.dumps(placing.to_dict())}  # fmt: skip
+    threshold, read = contact_metadata(good, "m.onnx")
+    assert threshold.tolist() == [1.0] * J and len(read.surface.link) == len(surface.link)
+    assert contact_metadata({}, "m.onnx") is None  # no watch
+    assert contact_metadata({**good, "contact_placing": ""}, "m.onnx")[1] is None  # before placing
+    short = placing.to_dict()
+    short["surface"]["normal"] = short["surface"]["normal"][:-1]
+    for bad, key, said in (
+        ({**good, "contact_threshold_nm": "[1, 2"}, "contact_threshold_nm", "Expecting"),
+        ({**good, "contact_threshold_nm": "[1, 2]"}, "contact_threshold_nm", "6 positive"),
+        ({**good, "contact_placing": "{}"}, "contact_placing", "surface"),
+        ({**good, "contact_placing": json.dumps(short)}, "contact_placing", "normal has shape"),
+        ({**good, "contact_placing": json.dumps({**placing.to_dict(), "noise_nm": [1.0]})},
+         "contact_placing", "one positive value per joint"),
+    ):  # fmt: skip
+        with pytest.raises(InputError, match=f"^m.onnx: metadata '{key}' cannot be read: .*{said}"):
+            contact_metadata(bad, "m.onnx")
 
 
 def test_bench_contact_times_a_resting_fleet_per_stream_count(capsys):
