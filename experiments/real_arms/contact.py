@@ -40,7 +40,7 @@ from robohealth_mj.recording.recorder import build_simulator, chunk_features
 from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, commission_thresholds
 from robohealth_mj.sim import pushes as sim_pushes
 from robohealth_mj.sim.ratings import rated_torque_nm
-from robohealth_mj.twin.pushes import nearest_joint, pushes
+from robohealth_mj.twin.pushes import most_distal_loaded, pushes
 
 ROOT = Path("outputs/real_arms")
 ARM = "ur10e"
@@ -96,7 +96,7 @@ def held_pose(pushed: str | None) -> tuple[np.ndarray, str | None]:
                  f"force_n: {force}, point_m: {point}}}]"]  # fmt: skip
     sim = build_simulator(compose_config("record", [*TWIN, *extra]))
     x = np.concatenate([chunk_features(c) for c in sim.run(round(HOLD_S / sim.tick_s))])
-    return x, sim_pushes.nearest_joint(sim.model, pushed) if pushed else None
+    return x, sim_pushes.joint_moving(sim.model, pushed) if pushed else None
 
 
 def sim_cells(held: list, policy: ContactPolicy, threshold: np.ndarray) -> tuple[int, int, int]:
@@ -126,7 +126,7 @@ def push_cells(x: np.ndarray, contact: np.ndarray, joint: np.ndarray) -> tuple[i
         shares.append(float(during.mean()))
         called += bool(during.any())
         named = Counter(joint[a : b + 1][during].tolist()).most_common(1)
-        agree += bool(named) and named[0][0] == nearest_joint(off[a : b + 1], SHARE)
+        agree += bool(named) and named[0][0] == most_distal_loaded(off[a : b + 1], SHARE)
     return called, agree, shares
 
 

@@ -46,7 +46,7 @@ from robohealth_mj.sim.contact_place import FRICTION, place, tangents
 from robohealth_mj.sim.contact_surface import arm_surface, geom_area, geom_in_body, geom_surface
 from robohealth_mj.sim.dynamics import nominal_model
 from robohealth_mj.sim.ratings import rated_torque_nm
-from robohealth_mj.twin.pushes import nearest_joint, pushes
+from robohealth_mj.twin.pushes import most_distal_loaded, pushes
 
 ROOT = Path("outputs/real_arms")
 ARM = "ur10e"
@@ -250,7 +250,7 @@ def real_part(logs: list[Path], noise: np.ndarray, accept: float) -> dict:
             joint = named[accept]
             force = "-" if joint is None else f"{np.linalg.norm(fits.force_n[joint]):.0f}"
             print(f"| {log.stem} | {first / TICK_HZ:.1f} | "
-                  f"{schema.JOINT_NAMES[nearest_joint(off[first : last + 1], SHARE)]} | "
+                  f"{schema.JOINT_NAMES[most_distal_loaded(off[first : last + 1], SHARE)]} | "
                   f"{short(watch_named(x, MARGIN * noise, first, last))} | "
                   f"{short(watch_named(x, MARGIN * noise, first, last, placing))} | "
                   f"{short(named[accept])} | " + " / ".join(f"{c:.1f}" for c in fits.chi2)

@@ -28,7 +28,7 @@ from robohealth_mj import schema
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 from robohealth_mj.runtime.sources import replay_stream
 from robohealth_mj.sim.ratings import rated_torque_nm
-from robohealth_mj.twin.pushes import nearest_joint, pushes
+from robohealth_mj.twin.pushes import most_distal_loaded, pushes
 
 LOGS = Path("outputs/real_arms/logs/collision")
 RESIDUAL = schema.feature_index("effort_residual")
@@ -83,7 +83,7 @@ def main() -> None:
                 alarm = any(d.alarm == "raised" for d in after)
                 named = Counter(d.localised_joint for d in faulty).most_common(1)
                 called = Counter(d.fault_class for d in faulty).most_common(1)
-                nearest = nearest_joint(off[first : last + 1], args.share)
+                nearest = most_distal_loaded(off[first : last + 1], args.share)
                 print(f"| {variant} | {log.stem} | {first / TICK_HZ:.1f} | "
                       f"{(last - first + 1) / TICK_HZ:.1f} | {len(faulty) / len(during):.2f} | "
                       f"{called[0][0] if called else '-'} | {'yes' if alarm else 'no'} | "

@@ -62,8 +62,8 @@ def read_pushes(entries: Sequence[dict], model: mujoco.MjModel) -> list[Push]:
     return out
 
 
-def nearest_joint(model: mujoco.MjModel, link: str) -> str:
-    """The joint nearest a force on ``link``: the one that moves it (its parent's for a body
+def joint_moving(model: mujoco.MjModel, link: str) -> str:
+    """The joint that moves ``link``, the joint nearest a force on it (its parent's for a body
     without a joint of its own, such as the payload)."""
     body = model.body(link).id
     while body > 0:

@@ -32,8 +32,9 @@ def pushes(
     return off, [(a, b) for a, b in episodes if b - a >= MIN_TICKS - 1]
 
 
-def nearest_joint(off: np.ndarray, share: float) -> int:
-    """The joint nearest a push: the most distal joint it loads by more than ``share`` of the
-    rating (a force on a link loads that link's joint and the joints before it, none after).
+def most_distal_loaded(off: np.ndarray, share: float) -> int:
+    """The most distal joint a push loads by more than ``share`` of the rating: the joint
+    nearest it or short of it (a force on a link loads the joints before it, none after, and
+    that link's own only through a lever about its axis).
     ``off [T, J]`` over the push's ticks."""
     return int(np.flatnonzero(off.max(axis=0) > share).max())

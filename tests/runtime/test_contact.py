@@ -21,7 +21,7 @@ from robohealth_mj.runtime.contact import (
     contact_metadata,
 )
 from robohealth_mj.sim.contact_surface import arm_surface
-from robohealth_mj.sim.pushes import nearest_joint, read_pushes
+from robohealth_mj.sim.pushes import joint_moving, read_pushes
 
 J = schema.N_JOINTS
 VEL, EFFORT, RESIDUAL = (schema.feature_index(n) for n in ("vel", "effort", "effort_residual"))
@@ -65,7 +65,7 @@ def test_a_push_on_a_held_pose_is_called_while_it_lasts_at_the_joint_nearest_it(
     during = [j for k, j in enumerate(called) if k in PUSH_TICKS and j >= 0]
     assert len(during) >= 0.75 * len(PUSH_TICKS)  # all but the force's rise and the confirming
     named = Counter(during).most_common(1)[0][0]
-    assert schema.JOINT_NAMES[named] == nearest_joint(sim.model, link)
+    assert schema.JOINT_NAMES[named] == joint_moving(sim.model, link)
     assert all(j < 0 for k, j in enumerate(called) if k not in range(120, 140))  # nor after
 
 
