@@ -1,8 +1,10 @@
 """The sim-to-real tables from ``experiments/real_arms/campaign.py``'s verdicts.
 
-    python experiments/real_arms/summarise.py [--runs GLOB,...] > results/real_arms/sim_to_real.md
+    python experiments/real_arms/summarise.py [--runs GLOB,...] [--intervals] > TABLE.md
 
 ``--runs``: only the runs (``outputs/real_arms/<run>/``) whose names match one of these globs.
+``--intervals``: instead, how sure each monitored share is: a 95 % interval with the logs
+resampled (the calls of a log are not independent ticks: most come in a few logs).
 
 Networks were replayed through the monitor (alarms, share of ticks called faulty); gbdt, which
 has no streaming form, by its window decisions (share of windows called faulty).
@@ -14,6 +16,8 @@ import argparse
 import json
 from fnmatch import fnmatch
 from pathlib import Path
+
+import numpy as np
 
 from robohealth_mj.logs.convert import convert_log
 
@@ -29,6 +33,7 @@ def kind_of(log: str) -> str:
 
 ROOT = Path("outputs/real_arms")
 TICK_HZ = 20.0
+RESAMPLES = 10_000  # of the logs, for the intervals
 
 
 def _rows(verdicts: Path, variant: str, kind: str) -> list[dict]:
@@ -91,15 +96,47 @@ def _line(run: str, v: str, what: str, rows: list[dict]) -> str:
             f"{alarms if alarms is not None else 'n/a'} | {rate} | {faulty:.3f} |")  # fmt: skip
 
 
+def intervals(runs: list[tuple[str, Path]], seed: int = 0) -> None:
+    """Per run and model: the monitored share called faulty, how many logs hold its calls, and
+    its 95 % interval with the logs resampled with replacement (percentiles)."""
+    rng = np.random.default_rng(seed)
+    print("## How sure the monitored share called faulty is\n")
+    print(f"The monitored healthy logs resampled with replacement ({RESAMPLES:,} times, seed "
+          f"{seed}); the interval is the 2.5th to 97.5th percentile of the share.\n")  # fmt: skip
+    print("| run | model | logs | ticks called faulty / decided | share | logs with a call "
+          "| 95 % interval |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    for run, verdicts in runs:
+        for v in sorted(p.name for p in verdicts.iterdir() if p.is_dir()):
+            rows = _rows(verdicts, v, "healthy")
+            if not rows:
+                continue
+            called = np.array([round(r["faulty"] * r["n"]) for r in rows], float)
+            decided = np.array([r["n"] for r in rows], float)
+            draws = rng.integers(len(rows), size=(RESAMPLES, len(rows)))
+            shares = called[draws].sum(axis=1) / np.maximum(decided[draws].sum(axis=1), 1)
+            low, high = np.percentile(shares, [2.5, 97.5])
+            print(f"| {run} | {v} | {len(rows)} | {called.sum():.0f} / {decided.sum():.0f} | "
+                  f"{called.sum() / decided.sum():.4f} | {(called > 0).sum()} | "
+                  f"{low:.4f}-{high:.4f} |")  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", default="*", help="comma-separated globs of run names")
-    globs = parser.parse_args().runs.split(",")
+    parser.add_argument(
+        "--intervals", action="store_true", help="only the shares' intervals, logs resampled"
+    )
+    args = parser.parse_args()
+    globs = args.runs.split(",")
     # campaign.py --name, and _program / _rate<R> where commissioned otherwise (--commission,
     # --healthy-rate), _motion where monitored with --observability motion
     runs = [(p.parent.name + p.name.removeprefix("verdicts"), p)
             for p in sorted(ROOT.glob("*/verdicts*"))
             if any(fnmatch(p.parent.name, g) for g in globs)]  # fmt: skip
+    if args.intervals:
+        intervals(runs)
+        return
     ablation(runs)
     print("## Healthy real running (after commissioning on the joint-wise logs, 6.8 min)\n")
     print("`program (selection)`: the twelve program logs (5.6 min), which no run is judged on "

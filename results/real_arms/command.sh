@@ -221,3 +221,7 @@ done
       echo
     done
   done; } > results/real_arms/cruise_strict.md
+# How sure those shares are (2026-11-27, twentieth session): the monitored logs resampled, a 95 %
+# interval per run (false_calls_interval.md; seconds)
+$PY experiments/real_arms/summarise.py --runs 'cruise,cruise_s4[3-6]' --intervals \
+  > results/real_arms/false_calls_interval.md
