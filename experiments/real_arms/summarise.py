@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Iterator
 from fnmatch import fnmatch
 from pathlib import Path
 
@@ -96,6 +97,15 @@ def _line(run: str, v: str, what: str, rows: list[dict]) -> str:
             f"{alarms if alarms is not None else 'n/a'} | {rate} | {faulty:.3f} |")  # fmt: skip
 
 
+def _monitored(runs: list[tuple[str, Path]]) -> Iterator[tuple[str, str, Path, list[dict]]]:
+    """``(run, model, verdicts, rows)`` for each run's models with monitored healthy logs."""
+    for run, verdicts in runs:
+        for v in sorted(p.name for p in verdicts.iterdir() if p.is_dir()):
+            rows = _rows(verdicts, v, "healthy")
+            if rows:
+                yield run, v, verdicts, rows
+
+
 def intervals(runs: list[tuple[str, Path]], seed: int = 0) -> None:
     """Per run and model: the monitored share called faulty, how many logs hold its calls, and
     its 95 % interval with the logs resampled with replacement (percentiles)."""
@@ -106,19 +116,15 @@ def intervals(runs: list[tuple[str, Path]], seed: int = 0) -> None:
     print("| run | model | logs | ticks called faulty / decided | share | logs with a call "
           "| 95 % interval |")  # fmt: skip
     print("|---|---|---|---|---|---|---|")
-    for run, verdicts in runs:
-        for v in sorted(p.name for p in verdicts.iterdir() if p.is_dir()):
-            rows = _rows(verdicts, v, "healthy")
-            if not rows:
-                continue
-            called = np.array([round(r["faulty"] * r["n"]) for r in rows], float)
-            decided = np.array([r["n"] for r in rows], float)
-            draws = rng.integers(len(rows), size=(RESAMPLES, len(rows)))
-            shares = called[draws].sum(axis=1) / np.maximum(decided[draws].sum(axis=1), 1)
-            low, high = np.percentile(shares, [2.5, 97.5])
-            print(f"| {run} | {v} | {len(rows)} | {called.sum():.0f} / {decided.sum():.0f} | "
-                  f"{called.sum() / decided.sum():.4f} | {(called > 0).sum()} | "
-                  f"{low:.4f}-{high:.4f} |")  # fmt: skip
+    for run, v, _, rows in _monitored(runs):
+        called = np.array([round(r["faulty"] * r["n"]) for r in rows], float)
+        decided = np.array([r["n"] for r in rows], float)
+        draws = rng.integers(len(rows), size=(RESAMPLES, len(rows)))
+        shares = called[draws].sum(axis=1) / np.maximum(decided[draws].sum(axis=1), 1)
+        low, high = np.percentile(shares, [2.5, 97.5])
+        print(f"| {run} | {v} | {len(rows)} | {called.sum():.0f} / {decided.sum():.0f} | "
+              f"{called.sum() / decided.sum():.4f} | {(called > 0).sum()} | "
+              f"{low:.4f}-{high:.4f} |")  # fmt: skip
 
 
 def main() -> None:
@@ -148,17 +154,13 @@ def main() -> None:
     print("| run | model | logs | n | healthy minutes | alarms | alarms / h "
           "| share called faulty |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|")
-    for run, verdicts in runs:
-        for v in sorted(p.name for p in verdicts.iterdir() if p.is_dir()):
-            rows = _rows(verdicts, v, "healthy")
-            if not rows:
-                continue
-            program = _rows(verdicts, v, "program")
-            if program:
-                print(_line(run, v, "program (selection)", program))
-            print(_line(run, v, "all monitored", rows))
-            for kind in sorted({kind_of(r["log"]) for r in rows}):
-                print(_line(run, v, kind, [r for r in rows if kind_of(r["log"]) == kind]))
+    for run, v, verdicts, rows in _monitored(runs):
+        program = _rows(verdicts, v, "program")
+        if program:
+            print(_line(run, v, "program (selection)", program))
+        print(_line(run, v, "all monitored", rows))
+        for kind in sorted({kind_of(r["log"]) for r in rows}):
+            print(_line(run, v, kind, [r for r in rows if kind_of(r["log"]) == kind]))
     for kind, title in (
         ("push", "Pushed while holding a pose"),
         ("load", "Runs with an added load"),
