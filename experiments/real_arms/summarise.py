@@ -113,18 +113,22 @@ def intervals(runs: list[tuple[str, Path]], seed: int = 0) -> None:
     print("## How sure the monitored share called faulty is\n")
     print(f"The monitored healthy logs resampled with replacement ({RESAMPLES:,} times, seed "
           f"{seed}); the interval is the 2.5th to 97.5th percentile of the share.\n")  # fmt: skip
+    print("Last column: the share over the program logs (selection) and the monitored ones "
+          "together, every healthy log that neither commissions nor trains.\n")  # fmt: skip
     print("| run | model | logs | ticks called faulty / decided | share | logs with a call "
-          "| 95 % interval |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|")
-    for run, v, _, rows in _monitored(runs):
+          "| 95 % interval | with the program logs |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
+    for run, v, verdicts, rows in _monitored(runs):
         called = np.array([round(r["faulty"] * r["n"]) for r in rows], float)
         decided = np.array([r["n"] for r in rows], float)
         draws = rng.integers(len(rows), size=(RESAMPLES, len(rows)))
         shares = called[draws].sum(axis=1) / np.maximum(decided[draws].sum(axis=1), 1)
         low, high = np.percentile(shares, [2.5, 97.5])
+        program = _rows(verdicts, v, "program")
+        pooled = f"{_faulty(rows + program):.4f}" if program else "not run"
         print(f"| {run} | {v} | {len(rows)} | {called.sum():.0f} / {decided.sum():.0f} | "
               f"{called.sum() / decided.sum():.4f} | {(called > 0).sum()} | "
-              f"{low:.4f}-{high:.4f} |")  # fmt: skip
+              f"{low:.4f}-{high:.4f} | {pooled} |")  # fmt: skip
 
 
 def main() -> None:
