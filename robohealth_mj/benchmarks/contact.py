@@ -53,8 +53,8 @@ def bench_contact(streams: list[int], arm: str = "ur10e", calls: int = 50) -> li
                      "tick_share": median / TICK_MS})  # fmt: skip
         print(f"| {n} | {median:.2f} | {p95:.2f} | {median / TICK_MS:.3f} |", flush=True)
     surface = arm_surface(arm)
-    noise = rng.uniform(0.5, 10.0, schema.N_JOINTS)
     j = schema.N_JOINTS
+    noise = rng.uniform(0.5, 10.0, j)
     pushes = [(rng.uniform(-3.0, 3.0, j), noise * rng.normal(0.0, 10.0, j)) for _ in range(calls)]
     calls_left = iter(pushes)
 

@@ -126,11 +126,10 @@ def place(
     lever = lever * scale[None, :, None]  # [P, J, 3]
     target = np.asarray(torque_nm, np.float64) * scale
     bound = _free_chi2(lever, target)
-    n_joints = len(surface.axis)
+    members = [np.flatnonzero(surface.link == j) for j in range(len(surface.axis))]  # per link
     chi2 = np.full(len(bound), np.inf)
     force = np.zeros((len(bound), 3))
-    todo = np.concatenate([np.flatnonzero(surface.link == j)[np.argsort(bound[surface.link == j])]
-                           [:SHORTLIST] for j in range(n_joints)])  # fmt: skip
+    todo = np.concatenate([m[np.argsort(bound[m])][:SHORTLIST] for m in members])
     while len(todo):
         edges = cone(normal[todo])  # [T, 3, E]
         prior = np.broadcast_to(np.eye(CONE_EDGES) / FORCE_SCALE_N, (len(todo), CONE_EDGES, 8))
@@ -139,10 +138,9 @@ def place(
             system, np.concatenate([target, np.zeros(CONE_EDGES)])
         )
         force[todo] = np.einsum("pke,pe->pk", edges, weights)
-        best = np.array([chi2[surface.link == j].min() for j in range(n_joints)])
+        best = np.array([chi2[m].min() for m in members])
         todo = np.flatnonzero(np.isinf(chi2) & (bound < best[surface.link]))
-    best_point = [np.flatnonzero(surface.link == j)[np.argmin(chi2[surface.link == j])]
-                  for j in range(n_joints)]  # fmt: skip
+    best_point = [m[np.argmin(chi2[m])] for m in members]
     fits = np.flatnonzero(chi2[best_point] <= accept)
     return Placement(chi2[best_point], force[best_point], int(fits[0]) if len(fits) else -1)
 
