@@ -47,12 +47,12 @@ bench: setup
 	$(BIN)/python -m robohealth_mj.bench sim
 
 lint: setup
-	$(BIN)/ruff check robohealth_mj tests experiments
-	$(BIN)/ruff format --check robohealth_mj tests experiments
+	$(BIN)/ruff check robohealth_mj tests studies
+	$(BIN)/ruff format --check robohealth_mj tests studies
 
 format: setup
-	$(BIN)/ruff format robohealth_mj tests experiments
-	$(BIN)/ruff check --fix robohealth_mj tests experiments
+	$(BIN)/ruff format robohealth_mj tests studies
+	$(BIN)/ruff check --fix robohealth_mj tests studies
 
 clean:
 	rm -rf $(VENV) outputs .pytest_cache .ruff_cache

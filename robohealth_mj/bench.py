@@ -5,7 +5,7 @@
     python -m robohealth_mj.bench train [--data 'outputs/corpus/quick/train_*'] [--window 32]
     python -m robohealth_mj.bench train --headline [OVERRIDE ...]
     python -m robohealth_mj.bench infer [--data outputs/corpus/quick/heldout_seed900] [--window 32]
-    python -m robohealth_mj.bench infer --model results/headline_physics/<model>.onnx
+    python -m robohealth_mj.bench infer --model MODEL.onnx
     python -m robohealth_mj.bench streams [--model M] [--streams 1000] [--seconds 30]
     python -m robohealth_mj.bench streams --profile 1000 2000 [--shards 1]
     python -m robohealth_mj.bench soak [--model M] [--streams 1000] [--seconds 60]
@@ -64,7 +64,7 @@ def main(argv: list[str] | None = None) -> None:
     infer.add_argument("--window", type=int, default=32)
     infer.add_argument("--batch", type=int, default=256)
     infer.add_argument("--model", default=None, help="an exported model (instead of --variants)")
-    headline = "results/headline_physics/anomaly_residual_w32_seed42.onnx"
+    headline = "studies/earlier_campaigns/results/headline_physics/anomaly_residual_w32_seed42.onnx"
     streams = sub.add_parser("streams", help="fleet load test: sustained 20 Hz streams")
     soak = sub.add_parser("soak", help="fleet under bad input: flags, tick budget, memory")
     ros2 = sub.add_parser("ros2", help="arms per monitor over DDS on loopback, end-to-end latency")

@@ -10,14 +10,14 @@ into ARCHIVE, a directory kept in git, and the report is built from ARCHIVE: eve
 so far, from any machine, not only those still on this one.
 
     python -m robohealth_mj.report outputs/thesis_physics \
-        --archive results/thesis_physics/runs --out results/thesis_physics
+        --archive studies/thesis_physics/results/runs --out studies/thesis_physics/results
 
-With ``--lives FILE`` (a ``lives.json`` of ``experiments/lives/campaign.py``) it draws each
+With ``--lives FILE`` (a ``lives.json`` of ``studies/wear/campaign.py``) it draws each
 held-out life instead: the wearing joint's true severity, the health index with its band and the
 RUL estimates against the true RUL (``--out``, default the file's directory).
 
     python -m robohealth_mj.report --lives outputs/lives/gbdt_last_s42/lives.json \
-        --out results/lives
+        --out studies/wear/results
 """
 
 from __future__ import annotations

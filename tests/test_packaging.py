@@ -1,6 +1,6 @@
 """What a user meets before any model: the wheel carries the configs and assets and runs from any
 directory, the deployment side imports no deep-learning stack, and the research scripts under
-``experiments/`` import only what the package has."""
+``studies/`` import only what the package has."""
 
 from __future__ import annotations
 
@@ -165,8 +165,8 @@ def _imports(path: Path) -> list[tuple[str, list[str], int]]:
     return found
 
 
-SCRIPTS = sorted((REPO / "experiments").rglob("*.py"))
-# rclpy and the ROS message packages: installed by experiments/ros2/*.sh in a venv of their own
+SCRIPTS = sorted((REPO / "studies").rglob("*.py"))
+# rclpy and the ROS message packages: installed by studies/ros2/*.sh in a venv of their own
 ROS_VENV = ("rclpy", "sensor_msgs", "diagnostic_msgs", "std_msgs", "builtin_interfaces")
 
 

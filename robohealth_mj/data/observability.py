@@ -8,7 +8,7 @@ one there is guessing from the rest of the window. The training label rule ``vis
 definition of *moved*; :func:`hide_unobservable` applies it to a model's decisions
 (``observability=motion`` in ``evaluate`` and ``monitor``): a model's belief in a motion-only
 fault on a joint that did not move goes to ``none``, which is what ``visible`` labels such a
-window. Measured on a real arm's healthy running in ``docs/real_arms.md``.
+window. Measured on a real arm's healthy running in ``studies/real_arms/README.md``.
 
 Pure numpy: the torch-free runtime applies it per tick, the evaluation per window.
 """

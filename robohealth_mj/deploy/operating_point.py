@@ -15,7 +15,7 @@ are as the model had them. Two recipes (``operating_point=``):
   the validation session's; every fault class pays, friction most (0.68 -> 0.45 recall).
 
 Chosen on a labelled validation session of an unseen program (``val_unseen_program``), see
-``docs/stock_arm.md``.
+``studies/stock_arm/README.md``.
 
 Matching validation's rate keeps the false calls validation has (a few per cent of healthy
 windows). A user who wants a quieter monitor names the healthy rate instead (``healthy_rate``,

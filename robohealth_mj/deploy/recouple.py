@@ -9,14 +9,14 @@ Two estimators of ``C`` (``placement_fit``):
   (where the packages were recorded), on 1 s block means; each of the arm's sensors is then a
   non-negative least-squares mixture of the predicted packages, pruned of the joints that barely
   help it. Mean correlation with the true placement 0.99 on five unseen placements, 0.92
-  unpruned (``results/stock/self_calibration.md``).
+  unpruned (``studies/stock_arm/results/self_calibration.md``).
 - ``reconstruction``: ``C`` refitted by gradient to minimise the model's own prediction error of
   each sensor from its coupled joints (``AnomalyResidualHead.reconstruction_error``); 0.32 with
   the earlier dense-edge pool model, -0.08 with the chosen one.
 
 Either only helps a model that has learned to use *any* placement (``trainer.placements``); a
 model trained on one placement has that placement in its sensor embeddings as well
-(``results/stock/recouple_trial.txt``).
+(``studies/stock_arm/results/recouple_trial.txt``).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ STEPS = 500
 LR = 0.05
 BLOCK = 20  # ticks (1 s) averaged per row of the motion estimator: drive noise averages out
 RIDGE = 0.1
-PRUNE = 0.006  # chosen on five validation placements (results/stock/pool_design.md)
+PRUNE = 0.006  # chosen on five validation placements (studies/stock_arm/results/pool_design.md)
 FITS = ("motion", "reconstruction")
 J, SENSORS = schema.N_JOINTS, schema.SENSOR_CHANNELS
 POS, VEL = schema.feature_index("pos"), schema.feature_index("vel")

@@ -3,7 +3,8 @@ placement nobody measured (commissioning, :mod:`robohealth_mj.deploy.commission`
 
 A model trained on one harness placement learns that placement into everything it has (the
 sensor nodes' embeddings, the predictor ``f``), so refitting ``C`` alone on another placement
-finds nothing (``results/stock/recouple_trial.txt``). Here every training window is mixed by a
+finds nothing (``studies/stock_arm/results/recouple_trial.txt``). Here every training window is
+mixed by a
 placement drawn from a pool (``random_coupling`` with the graph's number of sensors) and the
 model is *given* that placement in place of its learned ``C``; what it learns is how to use any
 placement. The sensors of every placement are z-scored on the healthy training snapshots, the

@@ -4,7 +4,8 @@ severity objective).
 A regression on faulted windows predicts the conditional mean (squared error) or median
 (absolute error) of the severity over every fault at once, and where the windows leave the level
 uncertain it settles between levels. Measured on the standard corpus's validation split (3
-levels, W = 32, ``results/lives/severity_objective.md``): squared error 0.143 MAE, absolute error
+levels, W = 32, ``studies/wear/results/severity_objective.md``): squared error 0.143 MAE,
+absolute error
 0.136, one level classifier over every fault 0.129 read as its expectation and 0.115 as its
 median, one per fault class mixed by the class posterior 0.100, and one per (fault class, joint)
 mixed by the class and joint posteriors 0.094 (held-out: 0.099 over three seeds, against 0.137

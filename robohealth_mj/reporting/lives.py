@@ -18,7 +18,7 @@ def read_lives(path: Path) -> dict[str, Any]:
     except (OSError, ValueError) as exc:
         raise InputError(f"{path}: not a lives result ({exc})") from None
     if not isinstance(data, dict) or not isinstance(data.get("rul"), list):
-        raise InputError(f"{path}: not a lives result (no 'rul' rows; experiments/lives)")
+        raise InputError(f"{path}: not a lives result (no 'rul' rows; studies/wear)")
     return data
 
 

@@ -7,7 +7,7 @@
   by default, because a best-effort reader matches both reliable and best-effort writers.
 - Fast DDS 3 peers (recent ROS 2's default middleware) advertise type information that Cyclone
   rejects unless told to ignore it for their vendor id (``Compatibility/IgnoreTypeInformation``).
-  Measured against rclpy on Fast DDS (``experiments/ros2/type_information.sh``): without it no
+  Measured against rclpy on Fast DDS (``studies/ros2/type_information.sh``): without it no
   message passes either way, with it every one does, so it is on by default; it concerns only
   that vendor id, so Cyclone peers are unaffected.
 - ``CYCLONEDDS_URI``, the way a ROS 2 user configures Cyclone (interfaces, peers, shared memory),

@@ -57,7 +57,7 @@ REPLACE_GROWTH = 1.5  # a contact is placed again when its torques have grown th
 class ContactPolicy:
     """How the watch reads a stream (ticks at the stream's rate; the defaults are for 20 Hz and
     were chosen on the real UR10e's program logs and first pushed log and on its twin pushed:
-    ``results/real_arms/contact.md``)."""
+    ``studies/real_arms/results/contact.md``)."""
 
     enabled: bool = True
     still_rad_s: float = 0.3

@@ -30,7 +30,8 @@ TASKS = ("pick_place", "palletise")  # the pick_place family's programs
 LEG_S = 0.8  # the shortest point-to-point move at speed scale 1, s
 JOINT_SPEED = 1.0  # rad/s: the fastest joint's peak speed in a move at speed scale 1 (a UR5e's)
 LIFT_RAD = (0.0, -0.25, 0.35, -0.1, 0.0, 0.0)  # from a pick or place pose to above it
-# Family cruise, after a real UR10e's point-to-point program (results/real_arms/moves.md): the
+# Family cruise, after a real UR10e's point-to-point program
+# (studies/real_arms/results/moves.md): the
 # leading joint reaches 0.70 rad/s in 0.72 s, cruises 1.0-5.6 s, brakes alike, and the next move
 # starts 0.04-0.06 s after the last one stops. The ramp here, 0.67 s, was read off the log's row
 # count before its dropped rows were noticed: 7 % steeper than the arm's, kept because every

@@ -238,7 +238,7 @@ def test_gbdt_severity_objective_l1_predicts_the_median_level():
         trees.fit(train, val, seed=0, threads=1)
         predicted[objective] = trees._booster("severity").predict(feats[split:])
         fitted[objective] = trees
-    # refitting one head (experiments/lives/severity_objective.py) keeps the others and equals
+    # refitting one head (studies/wear/severity_objective.py) keeps the others and equals
     # a model trained with that objective from the start
     refit, classes = fitted["regression"], fitted["regression"].class_booster.clone()
     refit.severity_objective = "regression_l1"

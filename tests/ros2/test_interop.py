@@ -24,7 +24,7 @@ from robohealth_mj.schema import FEATURE_NAMES, JOINT_NAMES
 
 ROS_WHEELS = ("ros-rclpy[fastrtps]", "ros-sensor-msgs", "ros-diagnostic-msgs")
 NODE = Path(__file__).with_name("ur_driver_node.py")
-# 3 s at 20 Hz; experiments/ros2/interop.sh runs it longer for the latency figure
+# 3 s at 20 Hz; studies/ros2/interop.sh runs it longer for the latency figure
 TICKS = int(os.environ.get("ROBOHEALTH_INTEROP_TICKS", "60"))
 
 

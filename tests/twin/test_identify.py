@@ -101,7 +101,7 @@ def test_identification_recovers_the_simulated_drives(twin):
     armature = np.array([got[j]["armature"] for j in JOINT_NAMES])
     np.testing.assert_allclose(armature, TRUE["armature"], rtol=0.05)  # from the model torque
     # friction and k_t from the current: within 10 % where the torque is large against the
-    # drive's ringing (shoulders, elbow); docs/real_arms.md gives every joint's recovery
+    # drive's ringing (shoulders, elbow); studies/real_arms/README.md gives every joint's recovery
     friction = np.array([got[j]["frictionloss"] for j in JOINT_NAMES])
     np.testing.assert_allclose(friction[:3], TRUE["frictionloss"][:3], rtol=0.10)
     np.testing.assert_allclose(content["torque_constant_nm_per_a"][:3], K_T[:3], rtol=0.10)

@@ -8,7 +8,7 @@ from typing import Any
 
 def cost_markdown(rows: list[dict[str, Any]], root: Path) -> str:
     """Wall time per run (mean over seeds, where measured) and per block (``blocks.tsv``, which
-    ``results/thesis_physics/command.sh`` appends to)."""
+    ``studies/thesis_physics/run.sh`` appends to)."""
     out = ["### Cost: wall time per run and per block", ""]
     blocks = root / "blocks.tsv"
     if blocks.is_file():

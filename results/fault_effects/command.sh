@@ -1,5 +1,0 @@
-#!/usr/bin/env bash
-# Physics fault effect sizes on every channel (schema 2.0): 6 faults x 3 joints x 3 severities, 30 s.
-set -euo pipefail
-PY=${PY:-.venv/bin/python}
-$PY -m robohealth_mj.effects --markdown --json results/fault_effects/physics.json > results/fault_effects/physics.md
