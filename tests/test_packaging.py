@@ -96,8 +96,8 @@ def test_the_monitor_runs_an_exported_model_without_torch(deployed, tmp_path):
 def wheel(tmp_path_factory) -> Path:
     """The project's wheel, built from this checkout with the setuptools already installed."""
     out, source = tmp_path_factory.mktemp("wheel"), tmp_path_factory.mktemp("source")
-    for name in ("pyproject.toml", "setup.py", "README.md"):  # a build writes beside its source:
-        shutil.copy2(REPO / name, source / name)  # build from a copy, never into the checkout
+    for name in ("pyproject.toml", "setup.py", "README.md", "LICENSE", "NOTICE"):  # a build writes
+        shutil.copy2(REPO / name, source / name)  # beside its source: build from a copy
     for name in ("robohealth_mj", "conf", "assets"):
         shutil.copytree(REPO / name, source / name, ignore=shutil.ignore_patterns("__pycache__"))
     done = subprocess.run(
@@ -121,6 +121,20 @@ def test_the_wheel_carries_every_config_and_asset(wheel):
             if p.is_file() and p.suffix in (".yaml", ".xml", ".md")
         }
         assert shipped and {f"{package}/{name}" for name in shipped} <= names, folder
+
+
+def test_the_wheel_carries_the_licence_and_the_notice(wheel):
+    """Apache-2.0 in the metadata, and the licence texts (ours, UR's BSD-3 for its numbers)."""
+    archive = zipfile.ZipFile(wheel)
+    names = archive.namelist()
+    (metadata,) = [n for n in names if n.endswith(".dist-info/METADATA")]
+    assert "License-Expression: Apache-2.0" in archive.read(metadata).decode()
+    licences = {n.rsplit("/", 1)[-1] for n in names if ".dist-info/licenses/" in n}
+    assert {"LICENSE", "NOTICE", "ur_description_licence.md"} <= licences
+    assert (
+        "Apache License"
+        in archive.read(next(n for n in names if n.endswith("licenses/LICENSE"))).decode()
+    )
 
 
 def test_the_installed_wheel_records_from_an_empty_directory(wheel, tmp_path):
