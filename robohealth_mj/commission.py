@@ -16,7 +16,9 @@ from omegaconf import OmegaConf
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.config import load_cli_config
 from robohealth_mj.common.errors import InputError, one_line_errors
-from robohealth_mj.deploy.commission import SETTLED, commission
+
+with one_line_errors("commission"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.deploy.commission import SETTLED, commission
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -32,7 +32,9 @@ from omegaconf import DictConfig
 from robohealth_mj.common.config import run_hydra_app
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.resources import HYDRA_CONF
-from robohealth_mj.recording.corpus import CORPUS_INDEX, build_corpus
+
+with one_line_errors("corpus"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.recording.corpus import CORPUS_INDEX, build_corpus
 
 
 @hydra.main(config_path=HYDRA_CONF, config_name="corpus", version_base="1.3")

@@ -12,9 +12,12 @@ from __future__ import annotations
 
 import argparse
 
-from robohealth_mj.faults.catalogue import FAULT_MODELS, MODES
-from robohealth_mj.recording.effect_sizes import COLUMNS, sweep, table_row
+from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.schema import JOINT_NAMES
+
+with one_line_errors("effects"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.faults.catalogue import FAULT_MODELS, MODES
+    from robohealth_mj.recording.effect_sizes import COLUMNS, sweep, table_row
 
 
 def main(argv: list[str] | None = None) -> None:

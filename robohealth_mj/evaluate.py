@@ -18,7 +18,9 @@ from omegaconf import DictConfig
 from robohealth_mj.common.config import run_hydra_app
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.resources import HYDRA_CONF
-from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
+
+with one_line_errors("evaluate"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 
 
 @hydra.main(config_path=HYDRA_CONF, config_name="evaluate", version_base="1.3")

@@ -14,7 +14,9 @@ from omegaconf import DictConfig
 from robohealth_mj.common.config import run_hydra_app
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.resources import HYDRA_CONF
-from robohealth_mj.deploy.export import export_checkpoint
+
+with one_line_errors("export"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.deploy.export import export_checkpoint
 
 
 @hydra.main(config_path=HYDRA_CONF, config_name="export", version_base="1.3")

@@ -16,7 +16,9 @@ from omegaconf import DictConfig
 from robohealth_mj.common.config import run_hydra_app
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.resources import HYDRA_CONF
-from robohealth_mj.recording.recorder import record_session, summary_text
+
+with one_line_errors("record"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.recording.recorder import record_session, summary_text
 
 
 @hydra.main(config_path=HYDRA_CONF, config_name="record", version_base="1.3")

@@ -20,8 +20,10 @@ from omegaconf import DictConfig
 
 from robohealth_mj.common.config import load_cli_config
 from robohealth_mj.common.errors import one_line_errors
-from robohealth_mj.deploy.episode import render_episode
 from robohealth_mj.runtime.metadata import read_metadata
+
+with one_line_errors("render"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.deploy.episode import render_episode
 
 
 def load_config(argv: list[str]) -> DictConfig:

@@ -26,9 +26,11 @@ import argparse
 from pathlib import Path
 
 from robohealth_mj.common.errors import InputError, one_line_errors
-from robohealth_mj.reporting.archive import archive_runs
-from robohealth_mj.reporting.build import build_report
-from robohealth_mj.reporting.lives import plot_lives, read_lives
+
+with one_line_errors("report"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.reporting.archive import archive_runs
+    from robohealth_mj.reporting.build import build_report
+    from robohealth_mj.reporting.lives import plot_lives, read_lives
 
 __all__ = ["build_report", "main"]
 

@@ -20,7 +20,9 @@ from omegaconf import DictConfig
 from robohealth_mj.common.config import register_resolvers, run_hydra_app
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.resources import HYDRA_CONF
-from robohealth_mj.learn.run import train_and_evaluate
+
+with one_line_errors("train"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.learn.run import train_and_evaluate
 
 register_resolvers()
 

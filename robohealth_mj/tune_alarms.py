@@ -16,7 +16,9 @@ from __future__ import annotations
 import argparse
 
 from robohealth_mj.common.errors import one_line_errors
-from robohealth_mj.deploy.alarm_sweep import choose, meets_targets, replay_decisions, sweep
+
+with one_line_errors("tune_alarms"):  # a missing extra is one line, not a traceback
+    from robohealth_mj.deploy.alarm_sweep import choose, meets_targets, replay_decisions, sweep
 
 
 def _f(value: float | None) -> str:

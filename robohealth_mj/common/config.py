@@ -53,6 +53,12 @@ def load_cli_config(
     cfg = OmegaConf.load(conf_dir() / f"{name}.yaml")
     for key in include:
         cfg[key] = OmegaConf.load(conf_dir() / f"{key}.yaml")
+    if argv and argv[0] in ("-h", "--help"):  # the file itself: every key, its default, why
+        texts = [(conf_dir() / f"{n}.yaml").read_text() for n in (name, *include)]
+        print(f"usage: python -m {prog} key=value ...\n\nconf/{name}.yaml:\n{texts[0]}", end="")
+        for key, text in zip(include, texts[1:], strict=True):
+            print(f"\n{key}.* (conf/{key}.yaml):\n{text}", end="")
+        raise SystemExit(0)
     keys = [a.split("=", 1)[0] for a in argv]
     unknown = [k for k in keys if k.split(".")[0] not in cfg]
     tool = prog.rsplit(".", 1)[-1]
@@ -70,7 +76,39 @@ def load_cli_config(
                 f"{arg}: not a value ({type(exc).__name__}); quote text that holds braces or "
                 "a colon, e.g. key='\"{arm}_\"'"
             ))) from None  # fmt: skip
+    for arg, value in zip(argv, given, strict=True):
+        _check_kind(cfg, arg.split("=", 1)[0], value, tool)
     return OmegaConf.merge(cfg, *given)
+
+
+_KINDS = (
+    (bool, "true or false"),
+    ((int, float), "a number"),
+    (str, "text"),
+    (dict, "a block of keys, each set on its own (key.name=value)"),
+    (list, "a list, [a, b]"),
+)
+
+
+def _kind(value: Any) -> tuple[type, str] | None:
+    return next((k for k in _KINDS if isinstance(value, k[0])), None)
+
+
+def _check_kind(cfg: DictConfig, key: str, given: DictConfig, tool: str) -> None:
+    """A value of another kind than the key's default (``speed=fast`` where a number goes,
+    ``alarm=3`` for a block of keys) is one line naming the key, not a failure deep inside the
+    tool. A default of null takes anything."""
+    default = OmegaConf.select(cfg, key, default=None)
+    value = OmegaConf.select(given, key)
+    if OmegaConf.is_config(default):
+        default = OmegaConf.to_container(default)
+    if OmegaConf.is_config(value):
+        value = OmegaConf.to_container(value)
+    want, have = _kind(default), _kind(value)
+    if want is None or value is None or have == want:
+        return
+    shown = f"keys {', '.join(default)}" if isinstance(default, dict) else f"default {default!r}"
+    raise SystemExit(report(tool, InputError(f"{key}={value!r}: {key} takes {want[1]} ({shown})")))
 
 
 def run_hydra_app(prog: str, app: Callable[[], Any]) -> None:

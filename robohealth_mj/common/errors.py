@@ -4,8 +4,9 @@ Library code raises :class:`InputError` (or the schema's ``SchemaError``, a bag'
 ``FileNotFoundError``) with a message that names the file and the line, field, topic or key; the
 entry points run their work inside :func:`one_line_errors`, which turns exactly those (and a
 config object whose constructor refused a value, which Hydra wraps) into
-``<prog>: error: <message>`` on stderr and ``SystemExit(2)``. Anything else is a bug and keeps its
-traceback.
+``<prog>: error: <message>`` on stderr and ``SystemExit(2)``. A third-party module that an extra
+brings and this install lacks is the user's error too: the line names the extra to install
+(:func:`missing_extra`). Anything else is a bug and keeps its traceback.
 """
 
 from __future__ import annotations
@@ -24,6 +25,36 @@ class InputError(ValueError):
 
 USER_ERRORS = (InputError, SchemaError, FileNotFoundError, IsADirectoryError, PermissionError)
 
+# The extra of pyproject.toml that brings each third-party module a command may need; the base
+# install (the deployment side) has none of them.
+EXTRA_OF = {
+    **dict.fromkeys(
+        ("mujoco", "dm_control", "scipy", "matplotlib", "PIL", "imageio", "imageio_ffmpeg"), "sim"
+    ),
+    **dict.fromkeys(
+        ("torch", "torch_geometric", "lightgbm", "sklearn", "onnxscript", "tensorboard"), "train"
+    ),
+    **dict.fromkeys(("cyclonedds", "pyarrow"), "monitor"),
+    "progpy": "prognostics",
+}
+
+
+def missing_extra(exc: BaseException) -> InputError | None:
+    """The one line for an import an extra would have satisfied, found anywhere in ``exc``'s
+    chain (Hydra and importlib wrap it); None when ``exc`` is not that."""
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        seen.add(id(exc))
+        if isinstance(exc, ImportError) and (exc.name or "").split(".")[0] in EXTRA_OF:
+            module = exc.name.split(".")[0]
+            extra = EXTRA_OF[module]
+            return InputError(
+                f"this needs the '{extra}' extra (no module '{module}' here): "
+                f"pip install 'robohealth_mj[{extra}]'"
+            )
+        exc = exc.__cause__ or exc.__context__
+    return None
+
 
 def report(prog: str, exc: BaseException) -> int:
     """Print the one line; the exit status for it."""
@@ -33,9 +64,12 @@ def report(prog: str, exc: BaseException) -> int:
 
 def user_error(exc: BaseException) -> BaseException | None:
     """The user's error behind ``exc``: itself, or, for a config object Hydra could not build
-    (``_target_``), the user error its constructor raised, prefixed with the config key."""
+    (``_target_``), the user error its constructor raised, prefixed with the config key; or
+    the extra a missing module needs."""
     if isinstance(exc, USER_ERRORS):
         return exc
+    if (extra := missing_extra(exc)) is not None:
+        return extra
     from hydra.errors import InstantiationException
 
     if isinstance(exc, InstantiationException) and isinstance(exc.__cause__, USER_ERRORS):
@@ -61,7 +95,7 @@ def exit_status(prog: str, run: Callable[[], int], *also: type[Exception]) -> in
     try:
         return run()
     except (*USER_ERRORS, *also) as exc:
-        return report(prog, exc)
+        return report(prog, missing_extra(exc) or exc)
     except Exception as exc:
         error = user_error(exc)
         if error is None:

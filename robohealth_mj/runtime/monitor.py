@@ -87,7 +87,7 @@ def monitor_stream(
     freeze_startup_heap()
     settle = runtime.window + policy.clear_after + evidence.clearing_ticks
     evaluator = OnlineEvaluator(settle_ticks=settle, arm=runtime.arm) if cfg.evaluate else None
-    last, started, t0 = None, time.perf_counter(), None
+    last, started, t0, valid = None, time.perf_counter(), None, 0
     wear = (
         SessionWear(cfg.stream_id, cfg.health) if cfg.get("health", {}).get("state_dir") else None
     )
@@ -99,6 +99,7 @@ def monitor_stream(
                 if delay > 0:
                     time.sleep(delay)
             t0 = t if t0 is None else t0
+            valid += isinstance(sample, GraphSample)
             d = runtime.process(cfg.stream_id, sample)
             if bag is not None and isinstance(sample, GraphSample):
                 bag.write_sample(sample)
@@ -110,6 +111,8 @@ def monitor_stream(
                 last = print_change(cfg.stream_id, t, d, truth, last)
             if wear is not None:
                 wear.add(d, runtime.fleet.joints)
+    if not valid:  # nothing was diagnosed: not a run to pass off as a healthy one
+        raise InputError(f"{cfg.file or cfg.source}: no valid sample to diagnose")
     if wear is not None:
         wear.finish()
     if cfg.bag_out:

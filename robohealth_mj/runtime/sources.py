@@ -9,6 +9,7 @@ from collections.abc import Iterator
 from robohealth_mj.bags import is_bag
 from robohealth_mj.bags.reader import read_bag_samples
 from robohealth_mj.common.config import compose_config
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.logs import is_log, log_samples
 from robohealth_mj.schema import FaultLabel, GraphSample, SchemaError, validate_sample
 
@@ -39,8 +40,15 @@ def replay_stream(path: str) -> Iterator[tuple[float, str | GraphSample, FaultLa
         for sample in read_bag_samples(path):
             yield sample.t, sample, sample.fault
         return
-    with open(path, encoding="utf-8") as handle:
-        for number, line in enumerate(handle, start=1):
+    with open(path, "rb") as handle:
+        for number, raw in enumerate(handle, start=1):
+            try:
+                line = raw.decode("utf-8")
+            except UnicodeDecodeError:
+                raise InputError(
+                    f"{path}:{number}: not text (bytes that are not UTF-8): replay reads a "
+                    "graphs.jsonl, a bag directory or a controller log (.csv, .parquet)"
+                ) from None
             try:
                 sample = validate_sample(json.loads(line), source=path, line=number)
             except (ValueError, SchemaError):
