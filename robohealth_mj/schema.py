@@ -146,6 +146,9 @@ class GraphSample:
     x: np.ndarray  # [N_NODES, N_FEATURES]
     fault: FaultLabel
     segment: dict[str, Any]
+    # A live sample's header stamp, exactly: ``t`` is it in float seconds, which at epoch times is
+    # up to 128 ns off, so a diagnosis stamped from ``t`` would not match the sample it diagnoses.
+    stamp_ns: int | None = None
 
 
 # The segment of a sample with no ground truth (a robot's own log or bag): nothing is known of it.

@@ -109,8 +109,9 @@ class MessageFactory:
         self.Status = types["diagnostic_msgs/msg/DiagnosticStatus"]
         self.KeyValue = types["diagnostic_msgs/msg/KeyValue"]
 
-    def header(self, t: float, frame: str = "") -> Any:
-        ns = stamp_ns(t)
+    def header(self, t: float, frame: str = "", ns: int | None = None) -> Any:
+        """A header stamped ``ns`` when the exact stamp is known, else ``t`` seconds."""
+        ns = stamp_ns(t) if ns is None else ns
         return self.Header(stamp=self.Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=frame)
 
     def diagnostics(
@@ -138,10 +139,13 @@ class MessageFactory:
             values=[self.KeyValue(key=k, value=v) for k, v in values.items()],
         )
 
-    def health_diagnosis(self, d: Any, classes: list[str], joints: list[str]) -> Any:
-        """The full diagnosis topic's message (one status, stamped with the sample's time)."""
+    def health_diagnosis(
+        self, d: Any, classes: list[str], joints: list[str], ns: int | None = None
+    ) -> Any:
+        """The full diagnosis topic's message (one status, stamped with the sample's time: its
+        exact header stamp ``ns`` where the sample came from a live bus)."""
         status = self.health_status(d, classes, joints, "health_diagnosis", d.model_id)
-        return self.DiagnosticArray(header=self.header(d.stamp), status=[status])
+        return self.DiagnosticArray(header=self.header(d.stamp, ns=ns), status=[status])
 
     def sample_messages(self, s: GraphSample, topics: BagTopics) -> list[tuple[str, Any]]:
         """``(topic, message)`` for every topic of one sample."""

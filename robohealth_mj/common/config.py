@@ -97,7 +97,7 @@ def _kind(value: Any) -> tuple[type, str] | None:
 def _check_kind(cfg: DictConfig, key: str, given: DictConfig, tool: str) -> None:
     """A value of another kind than the key's default (``speed=fast`` where a number goes,
     ``alarm=3`` for a block of keys) is one line naming the key, not a failure deep inside the
-    tool. A default of null takes anything."""
+    tool. A default of null takes anything, a word default a number too."""
     default = OmegaConf.select(cfg, key, default=None)
     value = OmegaConf.select(given, key)
     if OmegaConf.is_config(default):
@@ -107,6 +107,8 @@ def _check_kind(cfg: DictConfig, key: str, given: DictConfig, tool: str) -> None
     want, have = _kind(default), _kind(value)
     if want is None or value is None or have == want:
         return
+    if want[0] is str and have is not None and have[0] == (int, float):
+        return  # a word default with a number beside it (cutoff_hz: auto or Hz)
     shown = f"keys {', '.join(default)}" if isinstance(default, dict) else f"default {default!r}"
     raise SystemExit(report(tool, InputError(f"{key}={value!r}: {key} takes {want[1]} ({shown})")))
 

@@ -13,6 +13,7 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.seeds import stream
 from robohealth_mj.data.baseline import shift
 
 # Every joint reaches at least one sensor, and every joint's row is distinct, so the six joints
@@ -151,7 +152,7 @@ def random_coupling(seed: int, sensors: int = 4, joints: int = schema.N_JOINTS) 
             f"a random placement needs 2 to {2 * joints} sensors (each joint reaches one or two), "
             f"got {sensors}"
         )
-    rng = np.random.default_rng([seed, 22])
+    rng = stream("graphs.placement", seed)
     while True:
         c = np.zeros((joints, sensors), np.float32)
         primary = rng.permutation(np.resize(rng.permutation(sensors), joints))

@@ -6,9 +6,8 @@ import copy
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.seeds import stream
 from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, FaultLabel
 
 MODES: tuple[str, ...] = FAULT_CLASSES[1:]
@@ -59,7 +58,7 @@ class FaultParameters:
         self.randomised = bool(randomise)
         physics, analytic = copy.deepcopy(dict(physics)), copy.deepcopy(dict(analytic))
         if self.randomised:
-            rng = np.random.default_rng([int(seed), 3])
+            rng = stream("faults.parameters", seed)
             for table in (physics, analytic):
                 for mode in sorted(table):
                     for key in sorted(table[mode]):

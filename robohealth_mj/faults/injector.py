@@ -14,6 +14,7 @@ import mujoco
 import numpy as np
 
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.seeds import stream
 from robohealth_mj.faults.catalogue import FAULT_MODELS, MECHANICAL, FaultParameters
 from robohealth_mj.faults.mechanical import DriveFaults
 from robohealth_mj.faults.readings import ReadingFaults, TickReadings
@@ -49,8 +50,8 @@ class FaultInjector:
         )
         # Separate streams: the physics of a fault is the same whether or not the analytic layer
         # draws random numbers too.
-        self.rng_physics = np.random.default_rng([int(seed), 5])
-        self.rng_readings = np.random.default_rng([int(seed), 6])
+        self.rng_physics = stream("faults.physics", seed)
+        self.rng_readings = stream("faults.readings", seed)
 
     def _mechanical(self, interval: Interval) -> bool:
         sc = interval.scenario

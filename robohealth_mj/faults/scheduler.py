@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.seeds import stream
 from robohealth_mj.faults.catalogue import MODES, Scenario
 from robohealth_mj.schema import JOINT_NAMES
 
@@ -75,7 +76,7 @@ class FaultScheduler:
 
     def order(self, pass_index: int) -> np.ndarray:
         if pass_index not in self._orders:
-            rng = np.random.default_rng([self.seed, 4, pass_index])
+            rng = stream("faults.schedule", self.seed, pass_index)
             self._orders[pass_index] = rng.permutation(len(self.scenarios))
         return self._orders[pass_index]
 

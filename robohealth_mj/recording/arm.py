@@ -16,6 +16,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
+from robohealth_mj.common.seeds import stream
 from robohealth_mj.faults.injector import FaultInjector, healthy_injector
 from robohealth_mj.faults.readings import TickReadings
 from robohealth_mj.schema import FaultLabel
@@ -72,7 +73,7 @@ class ArmSimulator:
         self.ticks_per_segment = _whole(curriculum.segment_s / self.tick_s, "ticks per segment")
         self.chunk_ticks = max(1, round(chunk_s / self.tick_s))
         self.payload_ramp_ticks = round(curriculum.payload_ramp_s / self.tick_s)
-        self.rng = np.random.default_rng([int(seed), 2])
+        self.rng = stream("recording.sensors", seed)
         self.data = mujoco.MjData(model)
         self.tick = 0  # ticks completed
         self.nstate = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)

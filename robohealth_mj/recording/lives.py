@@ -27,6 +27,7 @@ from tqdm import tqdm
 
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.seeds import stream
 from robohealth_mj.common.version import code_version
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.relative import to_raw
@@ -67,7 +68,7 @@ def plan_lives(corpus: DictConfig) -> list[LifeSpec]:
             )
         paths = r.get("paths") or list(PATH_KINDS)
         joints = r.get("joints") or list(JOINT_NAMES)
-        rng = np.random.default_rng([int(r["seed"]), 11])
+        rng = stream("lives.draw", r["seed"])
         for i in range(int(r["lives"])):
             seed = int(r["seed"]) + i
             mode = modes[i % len(modes)]
@@ -147,7 +148,7 @@ def record_life(spec: LifeSpec, corpus: DictConfig, out_dir: Path, extra: list[s
     except (OSError, ValueError):
         pass
     threshold = float(corpus.threshold)
-    rng = np.random.default_rng([spec.seed, 12])
+    rng = stream("lives.path", spec.seed)
     path = draw_path(spec.path, threshold, rng) if spec.mode else None
     arm = str(OmegaConf.select(corpus, "arm", default=None) or "ur5e")
     rated = load_arm(arm).rated_torque

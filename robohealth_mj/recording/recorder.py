@@ -228,7 +228,8 @@ def record_session(cfg: DictConfig, out_dir: Path | str) -> RecordingResult:
         "rates": {"physics_hz": 1.0 / sim.dt, "tick_hz": 1.0 / sim.tick_s},
         "expected_samples": n_ticks,
         "faults": sim.faults.describe(),
-        "arm": sim.arm,
+        "arm": sim.ratings["arm"],  # the arm's name; the factors drawn for it apart
+        "arm_variation": sim.arm,
         "arm_ratings": sim.ratings,
         "config": session_config(cfg),
     }

@@ -21,7 +21,7 @@ from __future__ import annotations
 import json
 from collections import deque
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -271,10 +271,11 @@ class ArmAssembler:
                 if isinstance(truth, MessageView) and truth.template is not None:
                     label, segment, run_id = truth.template.truth
                     sample = GraphSample(run_id, truth.index, stamp / 1e9, x, label,
-                                         json.loads(segment))  # fmt: skip
+                                         json.loads(segment), stamp)  # fmt: skip
                 else:
                     try:
                         sample = labelled_sample(stamp / 1e9, x, _in_full(truth), where)
+                        sample = replace(sample, stamp_ns=stamp)
                     except (AttributeError, TypeError, ValueError) as exc:
                         raise _Problem(f"{_at(stamp)}: malformed message ({exc})") from None
                 self.count += 1

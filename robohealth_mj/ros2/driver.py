@@ -235,7 +235,7 @@ class DriverAssembler:
         x = node_features(state, np.zeros((N_JOINTS, len(SENSOR_FEATURES)))).astype(np.float32)
         index = round((stamp - self.origin) / self.period_ns)
         return GraphSample(self.arm, index, stamp / 1e9, x, FaultLabel(),
-                           dict(UNLABELLED_SEGMENT))  # fmt: skip
+                           dict(UNLABELLED_SEGMENT), stamp)  # fmt: skip
 
 
 class DriverMessages:

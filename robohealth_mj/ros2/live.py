@@ -111,6 +111,7 @@ def run_monitor(
     node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
                        stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
                        health_diagnosis_hz=float(cfg.get("health_diagnosis_hz", 20.0)),
+                       tick_hz=float(cfg.get("tick_hz", 20.0)),
                        diagnose_wait_s=float(cfg.get("diagnose_wait_s", 0.02)),
                        **layout_options(cfg, tracking))  # fmt: skip
     started = time.monotonic()

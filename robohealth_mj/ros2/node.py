@@ -195,9 +195,11 @@ class MonitorNode:
         driver: DriverConfig | None = None,
         health_diagnosis_hz: float = 20.0,
         diagnose_wait_s: float = 0.02,
+        tick_hz: float = 20.0,
     ) -> None:
         """``health_diagnosis_hz``: each arm's ``/health_diagnosis`` at most this often (every
-        diagnosis at the 20 Hz tick; less saves the monitor's publishing time at many arms).
+        diagnosis at ``tick_hz``, the model's rate; less saves the monitor's publishing time at
+        many arms).
         ``joint_names`` (a preset of ``conf/joint_names.yaml`` or six names) and ``tf_prefix``
         (``{arm}`` is the arm's name) say what each arm's JointState messages call its joints;
         ``namespace`` where its topics live; ``driver`` the UR driver's side (``ur_driver``).
@@ -206,7 +208,7 @@ class MonitorNode:
         self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
         if not health_diagnosis_hz > 0:
             raise InputError(f"ros2.health_diagnosis_hz must be > 0, got {health_diagnosis_hz}")
-        self.health_every = max(1, round(20.0 / health_diagnosis_hz))  # every k-th diagnosis
+        self.health_every = max(1, round(tick_hz / health_diagnosis_hz))  # every k-th diagnosis
         if not diagnose_wait_s >= 0:
             raise InputError(f"ros2.diagnose_wait_s must be >= 0, got {diagnose_wait_s}")
         self.diagnose_wait_s = diagnose_wait_s
@@ -336,12 +338,13 @@ class MonitorNode:
         fleet = self.runtime.fleet
         t0 = time.perf_counter()
         writer = self.diagnosis_writers[arm]
+        stamp = sample.stamp_ns if sample.stamp_ns is not None else stamp_ns(d.stamp)
         if writer._use_version_2:  # the byte encoder writes XCDR1, as ROS 2 types are
-            writer.write(self.factory.health_diagnosis(d, fleet.classes, fleet.joints))
+            writer.write(self.factory.health_diagnosis(d, fleet.classes, fleet.joints, stamp))
         else:
             level, message, values = health_fields(d, fleet.classes, fleet.joints)
             data = encode_diagnostic_array(
-                stamp_ns(d.stamp), "", [(level, "health_diagnosis", message, d.model_id, values)]
+                stamp, "", [(level, "health_diagnosis", message, d.model_id, values)]
             )
             Bus.write_serialized(writer, data)
         self._publishing += time.perf_counter() - t0
@@ -362,8 +365,8 @@ class MonitorNode:
         if state.last_sample_wall is not None and now - state.last_sample_wall > self.stale_s:
             msg.level = status.STALE
             msg.message = f"no sample for {now - state.last_sample_wall:.1f} s"
-        elif state.problem is not None:
-            msg.level = max(int(msg.level), status.WARN)
+        elif state.problem is not None:  # bad input, diagnosed or not yet: WARN, never STALE
+            msg.level = status.WARN if d is None else max(int(msg.level), status.WARN)
             msg.message = f"bad input: {state.problem}"
         for key in ("problems", "late", "duplicates"):
             msg.values.append(self.factory.KeyValue(key=key, value=str(getattr(state, key))))

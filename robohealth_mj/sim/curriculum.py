@@ -21,6 +21,7 @@ from functools import cache
 import numpy as np
 
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.seeds import stream
 from robohealth_mj.schema import N_JOINTS
 from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 
@@ -229,14 +230,14 @@ class Curriculum:
         return len(self.segments)
 
     def _order(self, pass_index: int) -> np.ndarray:
-        return np.random.default_rng([self.seed, 0, pass_index]).permutation(len(self.segments))
+        return stream("curriculum.order", self.seed, pass_index).permutation(len(self.segments))
 
     def scheduled(self, visit: int) -> ScheduledSegment:
         """The ``visit``-th segment of the session (passes reshuffle; random access is cheap)."""
         if visit not in self._cache:
             n = len(self.segments)
             segment = self.segments[int(self._order(visit // n)[visit % n])]
-            rng = np.random.default_rng([self.seed, 1, visit])
+            rng = stream("curriculum.segment", self.seed, visit)
             center = self.home + rng.uniform(-1.0, 1.0, N_JOINTS) * self.jitter
             start = self.home if visit == 0 else self.scheduled(visit - 1).center
             self._cache[visit] = ScheduledSegment(
@@ -255,7 +256,7 @@ class Curriculum:
         """A pick_place segment's poses ``[K, 6]``, from its start to its centre: over the pick,
         down, up, over the place (a palletising layer's next cell), down, up, centre."""
         sched = self.scheduled(visit)
-        rng = np.random.default_rng([self.seed, 3, visit])
+        rng = stream("curriculum.pick_place", self.seed, visit)
         pick = sched.center + rng.uniform(-0.4, 0.4, N_JOINTS) * self.amplitude
         if sched.segment.waveform == "palletise":  # cells of a 3 x 2 layer, in turn
             cell = visit % 6
@@ -291,7 +292,7 @@ class Curriculum:
         ``CRUISE_STROKE_RAD``, so the two moves (start to via, via to centre) are long; drawn in
         towards the midpoint of start and centre until both moves fit 95 % of the segment."""
         sched = self.scheduled(visit)
-        rng = np.random.default_rng([self.seed, 4, visit])
+        rng = stream("curriculum.cruise", self.seed, visit)
         via = sched.center + rng.uniform(-1.0, 1.0, N_JOINTS) * np.asarray(CRUISE_STROKE_RAD)
         middle = 0.5 * (sched.start_pose + sched.center)
         while sum(d for d, _ in self._cruise_timings(visit, via)) > self._cruise_room():

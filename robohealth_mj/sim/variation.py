@@ -17,6 +17,7 @@ import mujoco
 import numpy as np
 
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.seeds import stream
 from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.arms import DEFAULT_ARM, known_arms
 from robohealth_mj.sim.model import ArmIndex
@@ -61,7 +62,7 @@ class ArmVariation:
         session's ``seed``), and the drawn factors (``{}`` when nominal: the model itself)."""
         if self.nominal:
             return model, {}
-        rng = np.random.default_rng([int(seed if self.seed is None else self.seed), 18])
+        rng = stream("sim.variation", seed if self.seed is None else self.seed)
         arm = copy.copy(model)
         idx = ArmIndex.of(arm)
 

@@ -20,6 +20,7 @@ from scipy.interpolate import CubicSpline
 from scipy.signal import butter, sosfiltfilt
 
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.seeds import stream
 from robohealth_mj.schema import N_JOINTS
 from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 from robohealth_mj.sim.curriculum import ScheduledSegment, Segment, smoothstep
@@ -97,7 +98,7 @@ class ReplayCurriculum:
         self, logs: list[np.ndarray], limits: np.ndarray, passes: int, hold_s: float, blend_s: float
     ) -> None:
         """The program on the grid, the spline through it and which log plays when."""
-        rng = np.random.default_rng([self.seed, 5])
+        rng = stream("twin.replay", self.seed)
         pieces = [logs[0][:1]]
         self._plays: list[tuple[float, int, float]] = []  # (start s, log, speed scale)
         for _ in range(passes):

@@ -43,6 +43,8 @@ def test_a_120_s_session_has_2400_valid_samples_and_a_complete_manifest(record_c
     assert on_disk["schema_version"] == schema.SCHEMA_VERSION == "2.0"
     assert on_disk["config"]["seed"] == 11
     assert on_disk["code_version"]
+    assert on_disk["arm"] == on_disk["arm_ratings"]["arm"] == "ur5e"  # the arm's name, by its key
+    assert on_disk["arm_variation"] == {}  # the nominal arm: no factor drawn
     assert max(on_disk["stats"]["tracking_rms_rad"].values()) < 0.01
     # the default fault schedule: 12 s faulted, 8 s healthy, labels on every sample
     active = [s.fault.active for s in samples]

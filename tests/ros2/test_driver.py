@@ -327,3 +327,26 @@ def test_a_model_reading_more_than_the_driver_gives_is_refused_in_one_line(stock
         "and the model reads the stock profile's: ['effort_residual'] missing; use a model "
         "trained with sensing=ur_driver"
     ]
+
+
+def test_a_diagnosis_is_stamped_with_its_sample_s_header_stamp_exactly():
+    """At epoch times a stamp in float seconds is up to 128 ns off: the driver's tick carries
+    its header stamp whole, and the diagnosis's header equals it to the nanosecond."""
+    from robohealth_mj.bags.messages import MessageFactory
+    from robohealth_mj.ros2.node import IdlStore
+    from robohealth_mj.runtime.runtime import HealthDiagnosis
+
+    epoch = 1_764_300_000_123_456_789  # 2025-11-28, 789 ns past a microsecond
+    samples = [dataclasses.replace(s, t=epoch / 1e9 + k * 0.05) for k, s in enumerate(_samples(6))]
+    stream = _driver_stream(samples)
+    for k, (_, msg) in enumerate(stream):  # exact stamps, not from the float seconds
+        msg.header = _header(epoch + (k // 6) * 2_000_000)
+    assembler = DriverAssembler("left", "/js", "/cs", UR, DriverConfig(tracking=False))
+    got, problems, _ = _run(assembler, [m for m in stream if m[0] == "/js"])
+    assert problems == [] and got
+    first = got[0]
+    assert first.stamp_ns == epoch and round(first.t * 1e9) != epoch  # the float loses it
+    d = HealthDiagnosis(stamp=first.t, stream_id="left", sample_index=0, valid=True)
+    factory = MessageFactory(IdlStore())
+    header = factory.health_diagnosis(d, ["none"], ["j"], first.stamp_ns).header
+    assert header.stamp.sec * 10**9 + header.stamp.nanosec == epoch

@@ -549,3 +549,20 @@ def test_a_stock_arm_publishing_its_joint_topics_alone_is_diagnosed_by_a_stock_m
         assert a.class_probabilities == pytest.approx(b.class_probabilities, abs=1e-5)
     for bus in (robot, monitor_bus):
         bus.close()
+
+
+def test_an_arm_with_only_bad_input_is_warn_and_health_follows_the_tick_rate():
+    """An arm that has never delivered a valid sample but sent bad messages is WARN naming the
+    problem (STALE is for silence); ``health_diagnosis_hz`` divides the configured tick rate."""
+    bus = Bus(_bus())
+    try:
+        node = MonitorNode(bus, ModelRuntime(None), ["arm1", "arm2"], tick_hz=125.0,
+                           health_diagnosis_hz=25.0)  # fmt: skip
+        assert node.health_every == 5
+        now = time.monotonic()
+        node.arms["arm1"].problem = "topic '/arm1/joint_states': field 'effort': 2 values"
+        bad, silent = node.arm_status("arm1", now), node.arm_status("arm2", now)
+        assert bad.level == 1 and "field 'effort'" in bad.message
+        assert silent.level == 3 and silent.message == "no sample yet"
+    finally:
+        bus.close()
