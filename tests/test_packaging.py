@@ -39,6 +39,8 @@ TORCH_FREE = (
     "robohealth_mj.ros2.live",
     "robohealth_mj.ros2.assembly",
     "robohealth_mj.runtime.online_report",
+    "robohealth_mj.runtime.contact",
+    "robohealth_mj.arms.description",
 )
 
 _BLOCKER = f"""
@@ -206,6 +208,7 @@ def test_a_research_script_imports_only_what_exists(script):
 # The layers, lowest first: a module may import from its own layer and those below it.
 LAYERS = (
     ("schema", "common"),
+    ("arms",),  # each arm's description and ratings: the runtime reads them without the simulator
     ("sim",),
     ("faults",),
     ("data", "logs", "bags"),  # recordings on disk, controller logs and bags: one layer of readers
@@ -228,6 +231,18 @@ def _layer_of(parts: tuple[str, ...]) -> int:
     if (PACKAGE / name).is_dir() or name == "schema":
         return next(k for k, layer in enumerate(LAYERS) if name in layer)
     return len(LAYERS) - 1
+
+
+def test_the_runtime_imports_neither_the_simulator_nor_torch():
+    """The streaming runtime reads arm data from ``arms/``, never from ``sim/`` (whose package
+    holds the MuJoCo model): no module of ``runtime/`` names ``robohealth_mj.sim``."""
+    offenders = [
+        f"{path.name}:{line}"
+        for path in sorted((REPO / "robohealth_mj" / "runtime").glob("*.py"))
+        for module, _, line in _imports(path)
+        if module.startswith(("robohealth_mj.sim", "torch"))
+    ]
+    assert not offenders, offenders
 
 
 def test_layers_point_one_way():

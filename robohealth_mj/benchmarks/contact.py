@@ -5,7 +5,7 @@ moving arm is not). Per stream count, the median and p95 wall time of one watch 
 streams, and its share of the 20 Hz tick (50 ms), measured in one run. The watch runs where the
 model carries contact thresholds (a commissioned model); a fleet of uncommissioned models pays
 nothing. Then what placing one contact on a link costs
-(:func:`robohealth_mj.sim.contact_place.place`, run when a contact is confirmed and again as it
+(:func:`robohealth_mj.arms.contact_place.place`, run when a contact is confirmed and again as it
 grows): the tick of the stream it is on pays it.
 """
 
@@ -16,9 +16,9 @@ from collections.abc import Callable
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.arms.contact_place import place
 from robohealth_mj.benchmarks.common import latency_ms
 from robohealth_mj.runtime.contact import ContactBank, ContactPolicy
-from robohealth_mj.sim.contact_place import place
 from robohealth_mj.sim.contact_surface import arm_surface
 
 TICK_MS = 50.0

@@ -20,7 +20,7 @@ from functools import cache
 import numpy as np
 
 from robohealth_mj import schema
-from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
+from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
 
 REFERENCE_ARM = DEFAULT_ARM  # relative channels are expressed in this arm's units
 TORQUE_CHANNELS = ("effort", "effort_residual")

@@ -187,9 +187,9 @@ def check_recordings(ckpt: dict[str, Any], files: list) -> None:
     (its sensing profile's: a full model on a controller log, say), or one of an arm the model was
     not trained on, unless it was trained for transfer (``transfer=true``, several arms): then
     any arm whose description ships reads, its channels relative to its own ratings."""
+    from robohealth_mj.arms.description import load_arm
     from robohealth_mj.data.read import recording_arm, recording_sensing
     from robohealth_mj.data.sensing import refuse_missing_channels
-    from robohealth_mj.sim.arms import load_arm
 
     sensing = graph_from_checkpoint(ckpt).sensing
     arms = list(ckpt.get("arms") or [])  # empty: trained on recordings that name no arm

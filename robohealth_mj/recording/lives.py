@@ -25,6 +25,7 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
+from robohealth_mj.arms.description import load_arm
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.seeds import stream
@@ -36,7 +37,6 @@ from robohealth_mj.faults.wear import PATH_KINDS, draw_path, joint_usage, path_r
 from robohealth_mj.recording.corpus import CORPUS_INDEX, SessionSpec, _is_complete, _session_config
 from robohealth_mj.recording.recorder import GRAPHS_FILE, MANIFEST_FILE, record_session
 from robohealth_mj.schema import JOINT_NAMES, feature_index
-from robohealth_mj.sim.arms import load_arm
 
 LIFE_FILE = "life.json"
 

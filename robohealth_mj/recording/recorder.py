@@ -23,6 +23,7 @@ from hydra.utils import instantiate
 from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
+from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.version import code_version
@@ -38,7 +39,6 @@ from robohealth_mj.schema import (
     SCHEMA_VERSION,
     FaultLabel,
 )
-from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 from robohealth_mj.sim.pushes import read_pushes
 from robohealth_mj.sim.twin_file import read_twin_noise
 

@@ -22,7 +22,7 @@ Per stream, per tick (vectorised over streams, no torch):
   become its own level), until every tick of the span was: what lasts that long is a new rest.
 - *Contact*: a joint's residual more than its threshold off the level for ``confirm`` ticks in a
   row. The joint named: where the model carries the arm's chain and surface, the link a single
-  push explains (:func:`robohealth_mj.sim.contact_place.place`: a push square on a joint's round
+  push explains (:func:`robohealth_mj.arms.contact_place.place`: a push square on a joint's round
   housing does not load that joint, so the most distal joint loaded can fall short of it),
   placed when the contact is confirmed and again whenever its torques have grown half as large
   again; otherwise, or where no single push explains them, the most distal joint over its
@@ -41,9 +41,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.arms.contact_place import ArmSurface, place
+from robohealth_mj.arms.ratings import rated_torque_nm
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.sim.contact_place import ArmSurface, place
-from robohealth_mj.sim.ratings import rated_torque_nm
 
 _POS = schema.feature_index("pos")
 _VEL = schema.feature_index("vel")

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.arms.description import DEFAULT_ARM
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.numeric import joint_scores_from_logits, softmax
 from robohealth_mj.data.observability import MOVING_RAD_S, check_observability, hide_unobservable
@@ -39,7 +40,6 @@ from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, contact_me
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
 from robohealth_mj.runtime.phases import NO_CLOCK, NoClock
-from robohealth_mj.sim.arms import DEFAULT_ARM
 
 log = logging.getLogger(__name__)
 

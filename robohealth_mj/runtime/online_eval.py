@@ -39,11 +39,11 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.arms.description import DEFAULT_ARM
+from robohealth_mj.arms.ratings import rated_torque_nm
 from robohealth_mj.data.observability import MOVING_RAD_S
 from robohealth_mj.runtime.runtime import HealthDiagnosis
 from robohealth_mj.schema import FaultLabel
-from robohealth_mj.sim.arms import DEFAULT_ARM
-from robohealth_mj.sim.ratings import rated_torque_nm
 
 
 @dataclass

@@ -24,9 +24,9 @@ with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     from dm_control import mjcf
 
+from robohealth_mj.arms.description import LINK_BODIES, ArmDescription
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
-from robohealth_mj.sim.arms import LINK_BODIES, ArmDescription
 
 REFERENCE_REACH_M = 0.85  # the UR5e, whose size the scene's cameras and housings are drawn for
 DRIVE_KEYS = ("armature", "damping", "frictionloss", "stiffness", "tendon_damping", "backlash",

@@ -1,5 +1,5 @@
 """An arm's chain and collision surface from its MuJoCo model, for placing a push on a link
-(:mod:`robohealth_mj.sim.contact_place`, which the runtime runs without MuJoCo).
+(:mod:`robohealth_mj.arms.contact_place`, which the runtime runs without MuJoCo).
 
 Why points on the collision geoms: a push lands on the arm's surface, and which link's surface
 a force's line can meet is what tells a push on a housing from one on the link before it.
@@ -10,8 +10,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from robohealth_mj.arms.contact_place import ArmSurface
 from robohealth_mj.schema import JOINT_NAMES
-from robohealth_mj.sim.contact_place import ArmSurface
 from robohealth_mj.sim.dynamics import nominal_model
 
 AROUND, ALONG = 16, 7  # surface points: around each geom, and along its axis

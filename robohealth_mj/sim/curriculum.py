@@ -20,10 +20,10 @@ from functools import cache
 
 import numpy as np
 
+from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.seeds import stream
 from robohealth_mj.schema import N_JOINTS
-from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 
 FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place", "hold", "cruise")
 WAVEFORMS = ("sine", "triangle", "compound")

@@ -8,7 +8,7 @@ from functools import lru_cache
 import mujoco
 import numpy as np
 
-from robohealth_mj.sim.arms import DEFAULT_ARM
+from robohealth_mj.arms.description import DEFAULT_ARM
 from robohealth_mj.sim.model import ArmIndex, build_model
 
 

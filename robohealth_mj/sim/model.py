@@ -1,7 +1,8 @@
 """Compiling an arm's MuJoCo model and naming its parts.
 
-The arm is data (``assets/<arm>/``, :mod:`robohealth_mj.sim.arms`); :mod:`robohealth_mj.sim.builder`
-turns it into MJCF with our drive model through dm-control's ``mjcf``, and ``mujoco`` compiles it.
+The arm is data (``assets/<arm>/``, :mod:`robohealth_mj.arms.description`);
+:mod:`robohealth_mj.sim.builder` turns it into MJCF with our drive model through dm-control's
+``mjcf``, and ``mujoco`` compiles it.
 """
 
 from __future__ import annotations
@@ -15,10 +16,10 @@ import mujoco
 import numpy as np
 from omegaconf import OmegaConf
 
+from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.resources import asset_dir, conf_dir
 from robohealth_mj.schema import JOINT_NAMES
-from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 from robohealth_mj.sim.builder import DRIVE_KEYS, HOME_POSE, DriveModel, build_arm_scene
 
 ASSET_DIR = asset_dir()

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from robohealth_mj.arms.description import DEFAULT_ARM, known_arms
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.seeds import stream
 from robohealth_mj.schema import JOINT_NAMES
-from robohealth_mj.sim.arms import DEFAULT_ARM, known_arms
 from robohealth_mj.sim.model import ArmIndex
 
 LINKS = ("shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link",

@@ -19,10 +19,10 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, sosfiltfilt
 
+from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.seeds import stream
 from robohealth_mj.schema import N_JOINTS
-from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
 from robohealth_mj.sim.curriculum import ScheduledSegment, Segment, smoothstep
 from robohealth_mj.twin.joint_log import read_joint_log
 

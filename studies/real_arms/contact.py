@@ -34,12 +34,12 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.arms.ratings import rated_torque_nm
 from robohealth_mj.common.config import compose_config
 from robohealth_mj.logs import log_samples
 from robohealth_mj.recording.recorder import build_simulator, chunk_features
 from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, commission_thresholds
 from robohealth_mj.sim import pushes as sim_pushes
-from robohealth_mj.sim.ratings import rated_torque_nm
 from robohealth_mj.twin.pushes import most_distal_loaded, pushes
 
 ROOT = Path("outputs/real_arms")

@@ -1,5 +1,5 @@
 """Where a push was: the most distal joint loaded against a force fit on the arm's kinematics
-(:mod:`robohealth_mj.sim.contact_place`) and the contact watch as deployed, which places its
+(:mod:`robohealth_mj.arms.contact_place`) and the contact watch as deployed, which places its
 contacts with that fit; where the truth is known and on the real pushes, where it is not.
 
     python studies/real_arms/contact_where.py [--run cruise]
@@ -37,15 +37,15 @@ import mujoco
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.arms.contact_place import ACCEPT as PLACE_ACCEPT
+from robohealth_mj.arms.contact_place import FRICTION, place, tangents
+from robohealth_mj.arms.ratings import rated_torque_nm
 from robohealth_mj.common.config import compose_config
 from robohealth_mj.logs import log_samples
 from robohealth_mj.recording.recorder import build_simulator, chunk_features
 from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, Placing, quiet_deviations
-from robohealth_mj.sim.contact_place import ACCEPT as PLACE_ACCEPT
-from robohealth_mj.sim.contact_place import FRICTION, place, tangents
 from robohealth_mj.sim.contact_surface import arm_surface, geom_area, geom_in_body, geom_surface
 from robohealth_mj.sim.dynamics import nominal_model
-from robohealth_mj.sim.ratings import rated_torque_nm
 from robohealth_mj.twin.pushes import most_distal_loaded, pushes
 
 ROOT = Path("outputs/real_arms")

@@ -25,9 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.arms.ratings import rated_torque_nm
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
 from robohealth_mj.runtime.sources import replay_stream
-from robohealth_mj.sim.ratings import rated_torque_nm
 from robohealth_mj.twin.pushes import most_distal_loaded, pushes
 
 LOGS = Path("outputs/real_arms/logs/collision")

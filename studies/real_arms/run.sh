@@ -182,7 +182,7 @@ $PY -m robohealth_mj.commission model="$CRUISE42/best.ckpt" arm=ur10e healthy_ra
 $PY studies/real_arms/events.py --run cruise --suffix _ownmotion_rate0.99 --observability motion \
   > studies/real_arms/results/events_contact.md
 # Which link a push is on (2026-11-27, nineteenth session): the most distal joint loaded (the
-# watch's name before), a force fit on the arm's kinematics (robohealth_mj/sim/contact_place.py)
+# watch's name before), a force fit on the arm's kinematics (robohealth_mj/arms/contact_place.py)
 # and the watch as deployed now, which places its contacts with that fit: on the twin pushed
 # where the truth is known, on kinematics alone at the real poses, and on the real pushes
 # (contact_where.md; about 2 minutes). events_contact.md above is the watch as deployed.

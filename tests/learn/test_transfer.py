@@ -11,6 +11,7 @@ import onnxruntime as ort
 import pytest
 
 from robohealth_mj import schema
+from robohealth_mj.arms.description import load_arm
 from robohealth_mj.common.config import compose_config
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import load_recordings
@@ -19,7 +20,6 @@ from robohealth_mj.deploy.export import export_checkpoint
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
 from robohealth_mj.learn.run import train_and_evaluate
 from robohealth_mj.recording.recorder import record_session
-from robohealth_mj.sim.arms import load_arm
 
 VEL, EFFORT, RESIDUAL, POS = (schema.feature_index(n)
                               for n in ("vel", "effort", "effort_residual", "pos"))  # fmt: skip

@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from robohealth_mj.arms.ratings import rated_torque_nm
 from robohealth_mj.runtime.online_eval import LOADED_SHARE, MOVED_SPEED, OnlineEvaluator
 from robohealth_mj.runtime.online_report import online_markdown
 from robohealth_mj.runtime.runtime import HealthDiagnosis
 from robohealth_mj.schema import JOINT_NAMES, FaultLabel
-from robohealth_mj.sim.ratings import rated_torque_nm
 
 J = len(JOINT_NAMES)
 

@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from hydra import compose, initialize_config_dir
 
+from robohealth_mj.arms.description import LINK_BODIES, known_arms, load_arm
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.resources import conf_dir
 from robohealth_mj.recording.recorder import build_simulator, record_session
 from robohealth_mj.schema import JOINT_NAMES
-from robohealth_mj.sim.arms import LINK_BODIES, known_arms, load_arm
 from robohealth_mj.sim.dynamics import gravity_torques
 from robohealth_mj.sim.model import HOME_POSE, ArmIndex, build_model, default_drives
 

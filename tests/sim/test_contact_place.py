@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 from scipy.optimize import nnls
 
-from robohealth_mj.schema import JOINT_NAMES
-from robohealth_mj.sim.contact_place import (
+from robohealth_mj.arms.contact_place import (
     FRICTION,
     ArmSurface,
     cone,
     nonnegative_least_squares,
     place,
 )
+from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.contact_surface import arm_surface
 from robohealth_mj.sim.dynamics import nominal_model
 

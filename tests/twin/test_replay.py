@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from robohealth_mj.arms.description import load_arm
 from robohealth_mj.common.config import compose_config
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.recording.recorder import record_session
-from robohealth_mj.sim.arms import load_arm
 from robohealth_mj.twin.replay import ReplayCurriculum
 
 HOME = np.array([0.0, -1.6, 1.4, -1.4, -1.5, 0.0])

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robohealth_mj.sim.arms import DEFAULT_ARM, load_arm
+from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
 
 
 def rated_torque_nm(arm: str = DEFAULT_ARM) -> np.ndarray:
