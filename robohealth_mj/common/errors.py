@@ -95,7 +95,7 @@ def exit_status(prog: str, run: Callable[[], int], *also: type[Exception]) -> in
     try:
         return run()
     except (*USER_ERRORS, *also) as exc:
-        return report(prog, missing_extra(exc) or exc)
+        return report(prog, exc)
     except Exception as exc:
         error = user_error(exc)
         if error is None:
