@@ -8,13 +8,12 @@ fingerprint, and the table says after how many healthy minutes the baseline sett
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
-from omegaconf import OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
 from robohealth_mj.common.atomic import atomic_write_json
-from robohealth_mj.common.config import load_cli_config
+from robohealth_mj.common.config import arm_choice, run_tool
 from robohealth_mj.common.errors import InputError, one_line_errors
 
 with one_line_errors("commission"):  # a missing extra is one line, not a traceback
@@ -22,8 +21,10 @@ with one_line_errors("commission"):  # a missing extra is one line, not a traceb
 
 
 def main(argv: list[str] | None = None) -> None:
-    args = sys.argv[1:] if argv is None else argv
-    cfg = load_cli_config("commission", args, "robohealth_mj.commission")
+    run_tool("commission", run, argv)
+
+
+def run(cfg: DictConfig) -> None:
     with one_line_errors("commission"):
         if not cfg.model or not cfg.healthy:
             raise InputError("usage: python -m robohealth_mj.commission model=CKPT healthy=DATA")
@@ -37,7 +38,7 @@ def main(argv: list[str] | None = None) -> None:
                             placement_fit=cfg.placement_fit,
                             placement_prune=cfg.get("placement_prune"),
                             operating_point=cfg.operating_point,
-                            arm=cfg.get("arm"),
+                            arm=arm_choice(cfg),
                             healthy_rate=cfg.get("healthy_rate"),
                             contact_margin=cfg.get("contact_margin"))  # fmt: skip
         atomic_write_json(out / "commissioning.json", record)

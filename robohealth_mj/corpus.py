@@ -25,20 +25,21 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import hydra
 from hydra.utils import instantiate
 from omegaconf import DictConfig
 
-from robohealth_mj.common.config import run_hydra_app
+from robohealth_mj.common.config import run_tool
 from robohealth_mj.common.errors import one_line_errors
-from robohealth_mj.common.resources import HYDRA_CONF
 
 with one_line_errors("corpus"):  # a missing extra is one line, not a traceback
     from robohealth_mj.recording.corpus import CORPUS_INDEX, build_corpus
 
 
-@hydra.main(config_path=HYDRA_CONF, config_name="corpus", version_base="1.3")
-def main(cfg: DictConfig) -> None:
+def main(argv: list[str] | None = None) -> None:
+    run_tool("corpus", run, argv)
+
+
+def run(cfg: DictConfig) -> None:
     out_dir = Path(cfg.out_dir)
     jobs = cfg.jobs or os.cpu_count() or 1
     extra = [f"faults.fault_model={cfg.fault_model}", *cfg.record_overrides]
@@ -54,4 +55,4 @@ def main(cfg: DictConfig) -> None:
 
 
 if __name__ == "__main__":
-    run_hydra_app("corpus", main)
+    main()

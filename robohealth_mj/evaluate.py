@@ -12,19 +12,20 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import hydra
 from omegaconf import DictConfig
 
-from robohealth_mj.common.config import run_hydra_app
+from robohealth_mj.common.config import run_tool
 from robohealth_mj.common.errors import one_line_errors
-from robohealth_mj.common.resources import HYDRA_CONF
 
 with one_line_errors("evaluate"):  # a missing extra is one line, not a traceback
     from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 
 
-@hydra.main(config_path=HYDRA_CONF, config_name="evaluate", version_base="1.3")
-def main(cfg: DictConfig) -> None:
+def main(argv: list[str] | None = None) -> None:
+    run_tool("evaluate", run, argv)
+
+
+def run(cfg: DictConfig) -> None:
     if not cfg.ckpt or not cfg.data:
         raise SystemExit("usage: python -m robohealth_mj.evaluate ckpt=PATH data=PATH [out=PREFIX]")
     with one_line_errors("evaluate"):
@@ -40,4 +41,4 @@ def main(cfg: DictConfig) -> None:
 
 
 if __name__ == "__main__":
-    run_hydra_app("evaluate", main)
+    main()

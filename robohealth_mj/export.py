@@ -8,24 +8,25 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import hydra
 from omegaconf import DictConfig
 
-from robohealth_mj.common.config import run_hydra_app
+from robohealth_mj.common.config import arm_choice, run_tool
 from robohealth_mj.common.errors import one_line_errors
-from robohealth_mj.common.resources import HYDRA_CONF
 
 with one_line_errors("export"):  # a missing extra is one line, not a traceback
     from robohealth_mj.deploy.export import export_checkpoint
 
 
-@hydra.main(config_path=HYDRA_CONF, config_name="export", version_base="1.3")
-def main(cfg: DictConfig) -> None:
+def main(argv: list[str] | None = None) -> None:
+    run_tool("export", run, argv)
+
+
+def run(cfg: DictConfig) -> None:
     if not cfg.ckpt:
         raise SystemExit("usage: python -m robohealth_mj.export ckpt=PATH [out=model.onnx]")
     out = cfg.out or Path(cfg.ckpt).with_name("model.onnx")
     with one_line_errors("export"):
-        result = export_checkpoint(cfg.ckpt, out, cfg.data, cfg.parity_windows, cfg.get("arm"))
+        result = export_checkpoint(cfg.ckpt, out, cfg.data, cfg.parity_windows, arm_choice(cfg))
     incremental = result["metadata"].get("incremental_parity_error")
     print(
         f"exported {result['metadata']['model_id']} for the {result['metadata']['arm']} -> "
@@ -37,4 +38,4 @@ def main(cfg: DictConfig) -> None:
 
 
 if __name__ == "__main__":
-    run_hydra_app("export", main)
+    main()

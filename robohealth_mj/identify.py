@@ -11,13 +11,12 @@ model (target moment and fitted friction) as a predictor of the current.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
-from omegaconf import OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
-from robohealth_mj.common.config import load_cli_config
+from robohealth_mj.common.config import arm_choice, run_tool
 from robohealth_mj.common.errors import InputError, one_line_errors
 from robohealth_mj.schema import JOINT_NAMES
 
@@ -42,8 +41,10 @@ def _cutoff(value) -> float | None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    args = sys.argv[1:] if argv is None else argv
-    cfg = load_cli_config("identify", args, "robohealth_mj.identify")
+    run_tool("identify", run, argv)
+
+
+def run(cfg: DictConfig) -> None:
     with one_line_errors("identify"):
         from robohealth_mj.twin.report import run_identification
 
@@ -51,7 +52,7 @@ def main(argv: list[str] | None = None) -> None:
         if not fit:
             raise InputError("usage: python -m robohealth_mj.identify arm=ARM fit=[LOG,...] "
                              "validate=[LOG,...] out=DIR")  # fmt: skip
-        result = run_identification(str(cfg.arm), fit, validate, cfg.map, Path(cfg.out),
+        result = run_identification(arm_choice(cfg), fit, validate, cfg.map, Path(cfg.out),
                                     _cutoff(cfg.get("cutoff_hz", "auto")))  # fmt: skip
     drives = result["twin"]["drive_overrides"]
     print(f"fitted on {result['twin']['fit']['seconds']:g} s of {len(fit)} log(s) -> "
@@ -70,7 +71,7 @@ def main(argv: list[str] | None = None) -> None:
         atomic_write_text(Path(cfg.out) / "fidelity.md", result["fidelity_md"])
         atomic_write_json(Path(cfg.out) / "fidelity.json", result["fidelity"])
         print(result["fidelity_md"])
-    print(f"record on it: python -m robohealth_mj.record arm={cfg.arm} "
+    print(f"record on it: python -m robohealth_mj.record arm={arm_choice(cfg)} "
           f"sim.twin={result['twin_file']}")  # fmt: skip
 
 

@@ -14,11 +14,9 @@ detection latency to class and joint, per fault class and severity.
 
 from __future__ import annotations
 
-import sys
-
 from omegaconf import DictConfig
 
-from robohealth_mj.common.config import load_cli_config
+from robohealth_mj.common.config import run_tool
 from robohealth_mj.common.errors import InputError, one_line_errors
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.contact import ContactPolicy
@@ -28,15 +26,15 @@ from robohealth_mj.runtime.monitor import monitor_stream, refuse_lacking_data
 from robohealth_mj.runtime.runtime import ModelRuntime
 
 
-def load_config(argv: list[str]) -> DictConfig:
-    return load_cli_config("monitor", argv, "robohealth_mj.monitor", include=("ros2",))
-
-
 def main(argv: list[str] | None = None) -> dict | None:
+    """The monitor's Hydra app (``conf/monitor.yaml``, ``ros2.*``); returns the evaluation."""
+    return run_tool("monitor", run, argv)
+
+
+def run(cfg: DictConfig) -> dict | None:
     import logging
 
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
-    cfg = load_config(sys.argv[1:] if argv is None else argv)
     policy = _policy("alarm", AlarmPolicy, cfg)
     evidence = _policy("evidence", EvidencePolicy, cfg)
     contact = _policy("contact", ContactPolicy, cfg)

@@ -9,20 +9,21 @@ Examples::
 
 from __future__ import annotations
 
-import hydra
 from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
-from robohealth_mj.common.config import run_hydra_app
+from robohealth_mj.common.config import run_tool
 from robohealth_mj.common.errors import one_line_errors
-from robohealth_mj.common.resources import HYDRA_CONF
 
 with one_line_errors("record"):  # a missing extra is one line, not a traceback
     from robohealth_mj.recording.recorder import record_session, summary_text
 
 
-@hydra.main(config_path=HYDRA_CONF, config_name="record", version_base="1.3")
-def main(cfg: DictConfig) -> None:
+def main(argv: list[str] | None = None) -> None:
+    run_tool("record", run, argv)
+
+
+def run(cfg: DictConfig) -> None:
     out_dir = cfg.session.out_dir or HydraConfig.get().runtime.output_dir
     with one_line_errors("record"):
         result = record_session(cfg, out_dir)
@@ -30,4 +31,4 @@ def main(cfg: DictConfig) -> None:
 
 
 if __name__ == "__main__":
-    run_hydra_app("record", main)
+    main()

@@ -14,11 +14,9 @@ import os
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before anything imports mujoco
 
-import sys
-
 from omegaconf import DictConfig
 
-from robohealth_mj.common.config import load_cli_config
+from robohealth_mj.common.config import run_tool
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.runtime.metadata import read_metadata
 
@@ -26,12 +24,11 @@ with one_line_errors("render"):  # a missing extra is one line, not a traceback
     from robohealth_mj.deploy.episode import render_episode
 
 
-def load_config(argv: list[str]) -> DictConfig:
-    return load_cli_config("render", argv, "robohealth_mj.render")
-
-
 def main(argv: list[str] | None = None) -> None:
-    cfg = load_config(sys.argv[1:] if argv is None else argv)
+    run_tool("render", run, argv)
+
+
+def run(cfg: DictConfig) -> None:
     with one_line_errors("render"):
         if cfg.model:
             read_metadata(cfg.model)  # a bad model file is the user's to fix, not a fallback

@@ -5,22 +5,26 @@
 
 Each arm publishes the bag topic layout under its namespace (``/<arm>/joint_states`` …) with
 ``/<arm>/fault_state`` as ground truth, so ``monitor source=ros2`` and its on-line evaluation run
-with no robot at all. Bus settings: ``conf/ros2.yaml`` (``ros2.domain_id``, ``ros2.interface`` …).
+with no robot at all. Bus settings: ``conf/ros2/default.yaml`` (``ros2.domain_id``,
+``ros2.interface`` …).
 """
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
+from omegaconf import DictConfig
+
 from robohealth_mj.bags import is_bag
-from robohealth_mj.common.config import load_cli_config
+from robohealth_mj.common.config import run_tool
 from robohealth_mj.common.errors import InputError, one_line_errors
 
 
-def main(argv: list[str] | None = None) -> int:
-    cfg = load_cli_config("robot", sys.argv[1:] if argv is None else argv, "robohealth_mj.robot",
-                          include=("ros2",))  # fmt: skip
+def main(argv: list[str] | None = None) -> int | None:
+    return run_tool("robot", run, argv)
+
+
+def run(cfg: DictConfig) -> int:
     with one_line_errors("robot"):
         from robohealth_mj.ros2.live import run_robot
         from robohealth_mj.runtime.sources import replay_stream, sim_stream

@@ -13,13 +13,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import hydra
 from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
-from robohealth_mj.common.config import register_resolvers, run_hydra_app
+from robohealth_mj.common.config import register_resolvers, run_tool
 from robohealth_mj.common.errors import one_line_errors
-from robohealth_mj.common.resources import HYDRA_CONF
 
 with one_line_errors("train"):  # a missing extra is one line, not a traceback
     from robohealth_mj.learn.run import train_and_evaluate
@@ -27,11 +25,14 @@ with one_line_errors("train"):  # a missing extra is one line, not a traceback
 register_resolvers()
 
 
-@hydra.main(config_path=HYDRA_CONF, config_name="train", version_base="1.3")
-def main(cfg: DictConfig) -> None:
+def main(argv: list[str] | None = None) -> None:
+    run_tool("train", run, argv)
+
+
+def run(cfg: DictConfig) -> None:
     with one_line_errors("train"):
         train_and_evaluate(cfg, Path(cfg.out_dir or HydraConfig.get().runtime.output_dir))
 
 
 if __name__ == "__main__":
-    run_hydra_app("train", main)
+    main()

@@ -1,5 +1,5 @@
 """Spatio-temporal GNN variants (thesis §2.4, Table 3) and the ``gbdt`` baseline, built from
-``conf/model/<name>.yaml`` (plus ``conf/backbone/<name>.yaml`` for the networks).
+``conf/variant/<name>.yaml`` (plus ``conf/backbone/<name>.yaml`` for the networks).
 
 Every model takes a normalised window ``x: [B, W, N, F]`` (N = J joints then M sensors) and returns
 a dict with ``class_logits [B, 7]``, ``joint_logits [B, J]`` and, where present,
@@ -8,7 +8,7 @@ a dict with ``class_logits [B, 7]``, ``joint_logits [B, J]`` and, where present,
 
 from robohealth_mj.models.build import build_model
 
-# The nine networks in the thesis's Table 3 order (each has conf/model/<name>.yaml).
+# The nine networks in the thesis's Table 3 order (each has conf/variant/<name>.yaml).
 NETWORK_VARIANTS: tuple[str, ...] = (
     "mlp",
     "gat",

@@ -19,7 +19,7 @@ def build_model(
     window: int,
     **overrides,
 ) -> nn.Module:
-    """``conf/model/<name>.yaml`` + the graph (``[N, N]`` adjacency, J joints first) -> module."""
+    """``conf/variant/<name>.yaml`` + the graph (``[N, N]`` adjacency, J joints first) -> module."""
     adjacency = torch.as_tensor(np.asarray(adjacency), dtype=torch.float32)
     if adjacency.ndim != 2 or adjacency.shape[0] != adjacency.shape[1]:
         raise ValueError(f"adjacency must be square [N, N], got {tuple(adjacency.shape)}")

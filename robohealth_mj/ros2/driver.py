@@ -57,7 +57,7 @@ DISTROS = {"humble": "humble", "jazzy": "jazzy", "kilted": "jazzy", "rolling": "
 
 @dataclass(frozen=True)
 class DriverConfig:
-    """The driver's side of ``conf/ros2.yaml`` (``ros2.layout=ur_driver``)."""
+    """The driver's side of ``conf/ros2/default.yaml`` (``ros2.layout=ur_driver``)."""
 
     controller_state: str = "scaled_joint_trajectory_controller/controller_state"
     distro: str = "jazzy"  # the ROS 2 distribution: the controller state's layout

@@ -34,8 +34,8 @@ def bus_config(cfg: DictConfig) -> Any:
 
 
 def layout_options(cfg: DictConfig, tracking: bool = True) -> dict[str, Any]:
-    """The arm-side settings of ``conf/ros2.yaml`` as keyword arguments of ``MonitorNode`` and
-    ``ArmPublisher``: layout, namespace, joint names and, for ``ur_driver``, the driver's side
+    """The arm-side settings of ``conf/ros2/default.yaml`` as keyword arguments of ``MonitorNode``
+    and ``ArmPublisher``: layout, namespace, joint names and, for ``ur_driver``, the driver's side
     (``tracking``: the model reads ``pos_error``, so the controller state is awaited)."""
     from robohealth_mj.ros2.driver import DriverConfig
 

@@ -31,10 +31,10 @@ from functools import cache
 from pathlib import Path
 
 from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.common.config import compose_config
 from robohealth_mj.common.steps import run_step
 from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.deploy.alarm_sweep import evaluate_policy, replay_many
-from robohealth_mj.monitor import load_config
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
 
@@ -130,7 +130,7 @@ def healthy_alarms(done: Path, arm_dir: Path) -> None:
     todo = [s for s in HEALTHY_HOUR if not (done / f"alarms_{s}.json").is_file()]
     if not todo:
         return
-    cfg = load_config([])
+    cfg = compose_config("monitor")
     policy, evidence = AlarmPolicy(**cfg.alarm), EvidencePolicy(**cfg.evidence)
     files = [arm_dir / session / "graphs.jsonl" for session in todo]
     print(f"+ alarms of {done} over {arm_dir.name}'s {', '.join(todo)}", flush=True)

@@ -65,14 +65,6 @@ def test_a_text_file_with_no_valid_sample_is_a_failed_run(capsys, tmp_path):
     assert f"{text}: no valid sample to diagnose" in _one_line(capsys, status)
 
 
-def test_help_prints_every_key_of_the_file_and_exits_0(capsys):
-    with pytest.raises(SystemExit) as status:
-        monitor(["--help"])
-    assert status.value.code == 0
-    out = capsys.readouterr().out
-    assert "raise_after:" in out and "ros2.* (conf/ros2.yaml)" in out
-
-
 def test_a_missing_module_names_the_extra_that_brings_it():
     try:
         raise RuntimeError("built") from ModuleNotFoundError(

@@ -5,9 +5,9 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from robohealth_mj.common.config import compose_config
 from robohealth_mj.deploy.episode import render_episode
 from robohealth_mj.deploy.render import EpisodeRenderer
-from robohealth_mj.render import load_config
 from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.model import HOME_POSE, ArmIndex, build_model
 
@@ -34,7 +34,8 @@ def test_a_tinted_joint_changes_its_pixels():
 
 
 def test_render_cli_writes_frames_gif_and_pngs(tmp_path):
-    cfg = load_config(
+    cfg = compose_config(
+        "render",
         [
             f"out={tmp_path / 'ep.gif'}",
             f"png_dir={tmp_path / 'png'}",
@@ -43,7 +44,7 @@ def test_render_cli_writes_frames_gif_and_pngs(tmp_path):
             "fps=5",
             "width=160",
             "height=120",
-        ]
+        ],
     )
     frames = render_episode(cfg)
     assert len(frames) == 5

@@ -20,7 +20,7 @@ from robohealth_mj.models.onnx import export_onnx, onnx_parity
 F = schema.N_FEATURES
 
 ROOT = conf_dir()
-CONF = ROOT / "model"
+CONF = ROOT / "variant"
 VARIANTS = sorted(p.stem for p in CONF.glob("*.yaml") if p.stem != "gbdt")
 HIDDEN = 16  # small, so the suite stays fast
 

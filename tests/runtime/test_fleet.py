@@ -417,14 +417,14 @@ def test_monitor_refuses_nonsense_alarm_and_evidence_settings(deployed, capsys):
     for bad, named in (
         ("alarm.min_confidence=2", "alarm: alarm min_confidence must lie in [0, 1], got 2"),
         ("evidence.clip=-1", "evidence: evidence clip and floor must be > 0, got -1"),
-        ("evidence.half_life=3", "evidence: EvidencePolicy.__init__() got an unexpected"),
+        ("evidence.half_life=3", "evidence.half_life: no such key"),
         ("contact.confirm=0", "contact: contact confirm must be at least 1 tick, got 0"),
     ):
         with pytest.raises(SystemExit) as info:
             monitor_main([f"model={deployed['structural_onnx']}", bad])
         assert info.value.code == 2
         err = capsys.readouterr().err
-        assert err.startswith(f"monitor: error: conf/monitor.yaml {named}"), err
+        assert err.startswith("monitor: error: ") and named in err, err
         assert len(err.strip().splitlines()) == 1
 
 

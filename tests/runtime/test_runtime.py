@@ -373,13 +373,13 @@ def test_recordings_replayed_together_get_the_decisions_each_gets_alone(deployed
 def test_monitor_diagnoses_the_simulator_live(deployed, deciding_alarm_args, tmp_path, capsys):
     """``source=sim``: the simulator's samples straight into the runtime, here with a backlash
     at the elbow held on from the start (a fault the deployed model was trained on)."""
-    fault = "faults=fixed,faults.schedule.fault_class=backlash,faults.schedule.joint=elbow"
+    fault = '"faults=fixed","faults.schedule.fault_class=backlash","faults.schedule.joint=elbow"'
     result = monitor_main(
         [
             f"model={deployed['structural_onnx']}",
             "source=sim",
             "duration_s=6",
-            f"sim_overrides=[seed=5,{fault},faults.schedule.severity=0.9]",
+            f'sim_overrides=["seed=5",{fault},"faults.schedule.severity=0.9"]',
             "evaluate=true",
             *deciding_alarm_args,
             f"out={tmp_path / 'sim.json'}",
@@ -409,15 +409,15 @@ def test_monitor_adds_each_session_to_the_arm_health_history(deployed, tmp_path,
     """``health.state_dir``: each monitored session becomes the arm's per-joint health index,
     kept across runs of the monitor; a worn elbow reads higher than the healthy day before."""
     state = tmp_path / "health"
-    fault = "faults=fixed,faults.schedule.fault_class=backlash,faults.schedule.joint=elbow"
-    days = {0: "faults=none", 1: f"{fault},faults.schedule.severity=0.9"}
+    fault = '"faults=fixed","faults.schedule.fault_class=backlash","faults.schedule.joint=elbow"'
+    days = {0: '"faults=none"', 1: f'{fault},"faults.schedule.severity=0.9"'}
     for day, faults in days.items():
         monitor_main(
             [
                 f"model={deployed['structural_onnx']}",
                 "source=sim",
                 "duration_s=6",
-                f"sim_overrides=[seed=5,{faults}]",
+                f'sim_overrides=["seed=5",{faults}]',
                 "quiet=true",
                 f"health.state_dir={state}",
                 f"health.day={day}",
