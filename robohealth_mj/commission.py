@@ -17,7 +17,8 @@ from robohealth_mj.common.config import arm_choice, run_tool
 from robohealth_mj.common.errors import InputError, one_line_errors
 
 with one_line_errors("commission"):  # a missing extra is one line, not a traceback
-    from robohealth_mj.deploy.commission import SETTLED, commission
+    from robohealth_mj.deploy.commission import commission
+    from robohealth_mj.deploy.commission_summary import commission_summary
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -42,49 +43,7 @@ def run(cfg: DictConfig) -> None:
                             healthy_rate=cfg.get("healthy_rate"),
                             contact_margin=cfg.get("contact_margin"))  # fmt: skip
         atomic_write_json(out / "commissioning.json", record)
-    print(f"{record['healthy_minutes']:g} healthy minutes -> {record['checkpoint']}")
-    for row in record["settling"]:
-        print(f"  after {row['minutes']:>4g} min: {row['relative_error']:.3f} of the final shift")
-    settled = record["settled_minutes"]
-    if "settling_skipped" in record:
-        print(f"residual baseline not used: {record['settling_skipped']}")
-    elif settled is not None:
-        print(f"baseline settled (within {SETTLED:.0%}) after {settled:g} min")
-    else:
-        print(f"baseline not settled within {SETTLED:.0%}: record more healthy running")
-    if "placement" in record:
-        p = record["placement"]
-        parts = [f"placement self-calibration ({p['fit']}): C refitted"]
-        if "reconstruction_before" in p:
-            before, after = p["reconstruction_before"], p["reconstruction_after"]
-            parts.append(f"reconstruction {before:.3f} -> {after:.3f}")
-        if "coupling_correlation" in p:
-            parts.append(f"corr. with the arm's placement {p['coupling_correlation']:.2f}")
-        print(", ".join(parts))
-        train = f"python -m robohealth_mj.train graph=harness graph.coupling_file={p['file']}"
-        print(f"placement found -> {p['file']} (a model trained on it: {train} ...)")
-    point = record.get("operating_point", {})
-    if "class_offset" in point:
-        print(
-            f"healthy operating point ({point['recipe']}): this arm's healthy windows called "
-            f"healthy {point['arm_healthy_rate_before']:.3f} -> "
-            f"{point['arm_healthy_rate_after']:.3f} (validation: "
-            f"{point['validation_healthy_rate']:.3f})"
-        )
-    if "healthy_rate_asked" in point:
-        print(
-            f"asked for {point['healthy_rate_asked']:g} healthy: validation's faulted windows "
-            f"called a fault {point['validation_fault_recall_before']:.3f} -> "
-            f"{point['validation_fault_recall_after']:.3f}"
-        )
-    contact = record.get("contact", {})
-    if "threshold_nm" in contact:
-        values = " / ".join(f"{v:.2f}" for v in contact["threshold_nm"])
-        print(f"contact watch: thresholds {values} N·m ({contact['rule']})")
-    elif contact:
-        print(f"contact watch off: {contact['skipped']}")
-    if "onnx" in record:
-        print(f"exported -> {record['onnx']}")
+    print(commission_summary(record))
 
 
 if __name__ == "__main__":

@@ -14,15 +14,14 @@ detection latency to class and joint, per fault class and severity.
 
 from __future__ import annotations
 
+import logging
+
 from omegaconf import DictConfig
 
 from robohealth_mj.common.config import run_tool
-from robohealth_mj.common.errors import InputError, one_line_errors
-from robohealth_mj.runtime.alarms import AlarmPolicy
-from robohealth_mj.runtime.contact import ContactPolicy
-from robohealth_mj.runtime.evidence import EvidencePolicy
-from robohealth_mj.runtime.metadata import read_metadata
-from robohealth_mj.runtime.monitor import monitor_stream, refuse_lacking_data
+from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.runtime.monitor import monitor_policies, monitor_stream
+from robohealth_mj.runtime.ready import resolve_file, resolve_model
 from robohealth_mj.runtime.runtime import ModelRuntime
 
 
@@ -32,45 +31,25 @@ def main(argv: list[str] | None = None) -> dict | None:
 
 
 def run(cfg: DictConfig) -> dict | None:
-    import logging
-
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
-    policy = _policy("alarm", AlarmPolicy, cfg)
-    evidence = _policy("evidence", EvidencePolicy, cfg)
-    contact = _policy("contact", ContactPolicy, cfg)
     with one_line_errors("monitor"):
-        return _monitor(cfg, policy, evidence, contact)
+        cfg.model, cfg.file = resolve_model(cfg.model), resolve_file(cfg.file)  # model=stock
+        alarm, evidence, contact = monitor_policies(cfg)
+        runtime = ModelRuntime(
+            cfg.model,
+            threads=cfg.threads,
+            alarm=alarm,
+            incremental=cfg.incremental,
+            evidence=evidence,
+            observability=cfg.observability,
+            contact=contact,
+            strict=True,
+        )  # fmt: skip (strict: a model named is read here, once, or refused)
+        if cfg.source != "ros2":
+            return monitor_stream(cfg, runtime, alarm, evidence)
+        from robohealth_mj.ros2.live import monitor_arms
 
-
-def _policy(key: str, kind: type, cfg: DictConfig):
-    """The ``alarm``, ``evidence`` or ``contact`` block as its policy; a bad value is the user's
-    to fix."""
-    with one_line_errors("monitor"):
-        try:
-            return kind(**cfg[key])
-        except (TypeError, ValueError) as exc:
-            raise InputError(f"conf/monitor.yaml {key}: {exc}") from None
-
-
-def _monitor(
-    cfg: DictConfig, policy: AlarmPolicy, evidence: EvidencePolicy, contact: ContactPolicy
-) -> dict | None:
-    if cfg.model:
-        read_metadata(cfg.model)  # a model named but unusable is the user's to fix
-    runtime = ModelRuntime(
-        cfg.model, threads=cfg.threads, alarm=policy, incremental=cfg.incremental,
-        evidence=evidence, observability=cfg.observability, contact=contact,
-    )  # fmt: skip
-    if cfg.source != "ros2":
-        return monitor_stream(cfg, runtime, policy, evidence)
-    from robohealth_mj.ros2 import layout_sensing
-
-    delivered = layout_sensing(cfg.ros2.layout)  # the channels the layout's topics carry
-    if cfg.model:  # a model reading more is refused
-        refuse_lacking_data(cfg.model, delivered, f"ros2.layout={cfg.ros2.layout}")
-    from robohealth_mj.ros2.live import monitor_arms
-
-    return monitor_arms(cfg, runtime, policy, evidence)
+        return monitor_arms(cfg, runtime, alarm, evidence)
 
 
 if __name__ == "__main__":

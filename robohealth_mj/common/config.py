@@ -47,6 +47,14 @@ def arm_choice(cfg: DictConfig) -> str | None:
     return None if arm is None else str(arm if isinstance(arm, str) else arm.name)
 
 
+def as_paths(value: Any) -> list[str]:
+    """A key that takes one path or a list of them (``fit=a.csv``, ``fit=[a.csv,b.csv]``)."""
+    if value is None:
+        return []
+    listed = OmegaConf.to_container(value) if OmegaConf.is_list(value) else [value]
+    return [str(v) for v in listed]
+
+
 def register_resolvers() -> None:
     """``${placement:${graph}}`` in the configs (run directories): see ``placement_name``."""
     OmegaConf.register_new_resolver("placement", placement_name, replace=True)

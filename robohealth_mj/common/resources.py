@@ -24,3 +24,11 @@ def asset_dir() -> Path:
     """The packaged ``assets/`` folder, or ``$ROBOHEALTH_ASSETS`` where a user points elsewhere."""
     override = os.environ.get("ROBOHEALTH_ASSETS")
     return Path(override) if override else Path(str(files(ASSETS_PACKAGE)))
+
+
+READY_PACKAGE = "robohealth_mj.ready_models"
+
+
+def ready_dir() -> Path:
+    """The packaged ready models (``ready_models/``: exported models, their cards, a sample)."""
+    return Path(str(files(READY_PACKAGE)))

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 from robohealth_mj.bags import is_bag
@@ -17,7 +18,10 @@ from robohealth_mj.data.jsonl import read_jsonl_samples
 from robohealth_mj.logs import is_log, log_samples, log_sensing
 from robohealth_mj.schema import GraphSample
 
-__all__ = ["is_bag", "is_log", "read_samples", "recording_arm", "recording_sensing"]
+__all__ = [
+    "RecordingFile", "is_bag", "is_log", "open_recording", "read_samples", "recording_arm",
+    "recording_sensing",
+]  # fmt: skip
 
 
 def _manifest(path: Path) -> dict:
@@ -30,30 +34,56 @@ def _manifest(path: Path) -> dict:
     return data if isinstance(data, dict) else {}
 
 
-def recording_sensing(path: Path | str) -> str:
-    """The sensing profile a recording carries: a controller log the joint channels its columns
-    give (``stock``, or ``stock_reduced`` without the target position), a bag without the sensor
-    topics ``stock``; a recording its manifest's ``sensing`` (an ingested log's says which); a
-    simulated one every channel (``full``)."""
+@dataclass(frozen=True)
+class RecordingFile:
+    """A recording looked at once: its kind (``log``, ``bag`` or ``jsonl``), the sensing profile
+    it carries and the arm it names, so a reader of it dispatches and reads its manifest once."""
+
+    path: Path
+    kind: str
+    sensing: str  # a log: the channels its columns give; a bag without sensor topics: stock;
+    # a recording: its manifest's (an ingested log's says which); a simulated one: full
+    arm: str | None  # the manifest's arm (every recording simulated since arms became data)
+
+
+def open_recording(path: Path | str) -> RecordingFile:
+    """What ``path`` is, read once; a path that is none of them is the user's to fix."""
     path = Path(path)
     if is_log(path):
-        return log_sensing(path)
+        return RecordingFile(path, "log", log_sensing(path), None)
     if is_bag(path):
         from robohealth_mj.bags.reader import bag_sensing
 
-        return bag_sensing(path)
-    return str(_manifest(path).get("sensing", "full"))
+        return RecordingFile(path, "bag", bag_sensing(path), None)
+    if path.is_dir() and (path / "graphs.jsonl").is_file():  # a session directory
+        path = path / "graphs.jsonl"
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"{path}: no recording there (a graphs.jsonl, a bag directory or a controller log, "
+            ".csv or .parquet)"
+        )
+    manifest = _manifest(path)
+    ratings = manifest.get("arm_ratings")
+    arm = ratings.get("arm") if isinstance(ratings, dict) else None
+    return RecordingFile(path, "jsonl", str(manifest.get("sensing", "full")), arm and str(arm))
+
+
+def recording_sensing(path: Path | str) -> str:
+    """The sensing profile a recording carries (:class:`RecordingFile`; a simulated one's,
+    ``full``, where nothing is there to say)."""
+    return _looked_at(path).sensing
 
 
 def recording_arm(path: Path | str) -> str | None:
-    """The arm a recording comes from, where its manifest says (``arm_ratings``: every recording
-    simulated since arms became data); ``None`` where nothing says (a log, a bag, an older one)."""
-    path = Path(path)
-    if is_log(path) or is_bag(path):
-        return None
-    ratings = _manifest(path).get("arm_ratings")
-    arm = ratings.get("arm") if isinstance(ratings, dict) else None
-    return str(arm) if arm else None
+    """The arm a recording names; ``None`` where nothing says (a log, a bag, an older one)."""
+    return _looked_at(path).arm
+
+
+def _looked_at(path: Path | str) -> RecordingFile:
+    try:
+        return open_recording(path)
+    except FileNotFoundError:
+        return RecordingFile(Path(path), "jsonl", "full", None)
 
 
 def read_samples(path: Path | str) -> Iterator[GraphSample]:

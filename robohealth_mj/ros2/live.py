@@ -1,5 +1,5 @@
 """Long-running loops on the bus: the monitor (``monitor source=ros2``: :func:`monitor_arms`,
-with its on-line evaluation per arm) and simulated arms
+live arms pushing into the monitor's session) and simulated arms
 (``python -m robohealth_mj.robot``). Both stop cleanly on Ctrl-C or SIGTERM: the last
 ``/diagnostics`` is published and the participants are closed."""
 
@@ -14,10 +14,8 @@ from typing import Any
 
 from omegaconf import DictConfig
 
-from robohealth_mj.common.atomic import atomic_write_json
+from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.ros2 import require_dds
-from robohealth_mj.runtime.monitor import evaluation_path
-from robohealth_mj.runtime.online_eval import OnlineEvaluator, joint_activity
 from robohealth_mj.schema import GraphSample
 
 
@@ -55,17 +53,6 @@ def layout_options(cfg: DictConfig, tracking: bool = True) -> dict[str, Any]:
     return {"layout": layout, "namespace": str(cfg.get("namespace", "/{arm}")),
             "joint_names": names, "tf_prefix": str(cfg.get("tf_prefix") or ""),
             "driver": driver}  # fmt: skip
-
-
-def reads_tracking_error(model: str | None) -> bool:
-    """Whether the exported model reads ``pos_error`` (then a UR driver's controller state is
-    awaited for every tick); without a model, nothing is awaited."""
-    if not model:
-        return False
-    from robohealth_mj.data.sensing import load_profile
-    from robohealth_mj.runtime.metadata import read_metadata
-
-    return "pos_error" in load_profile(read_metadata(model).get("sensing", "full")).joint_channels
 
 
 @contextmanager
@@ -176,27 +163,24 @@ def run_robot(cfg: DictConfig, stream: Iterator[tuple[float, GraphSample]]) -> i
 
 
 def monitor_arms(cfg: DictConfig, runtime: Any, policy: Any, evidence: Any) -> dict | None:
-    """``source=ros2``: live arms on the bus; with ``evaluate``, one on-line evaluation per arm
-    against its ``fault_state``, as for a replay."""
-    settle = runtime.window + policy.clear_after + evidence.clearing_ticks
-    evaluators: dict[str, OnlineEvaluator] = {}
+    """``source=ros2``: live arms on the bus pushing into the monitor's session (the one a
+    replay is pulled through): with ``evaluate``, one on-line evaluation per arm against its
+    ``fault_state``; with ``health.state_dir``, each arm's wear."""
+    from robohealth_mj.ros2 import layout_sensing
+    from robohealth_mj.runtime.monitor import MonitorSession, refuse_lacking_data
 
-    def evaluate(arm: str, sample: GraphSample, d: Any) -> None:
-        if arm not in evaluators:
-            evaluators[arm] = OnlineEvaluator(settle_ticks=settle, arm=runtime.arm)
-        evaluators[arm].update(sample.fault, d, *joint_activity(sample.x))
+    if runtime.fleet.engine is not None:  # a model reading more than the layout carries
+        layout = cfg.ros2.layout
+        refuse_lacking_data(runtime.fleet.sensing, layout_sensing(layout), f"ros2.layout={layout}")
+    with MonitorSession(cfg, runtime, policy, evidence, print_changes=False) as session:
 
-    counts = run_monitor(cfg.ros2, runtime, cfg.duration_s or None,
-                         evaluate if cfg.evaluate else None,
-                         reads_tracking_error(cfg.model))  # fmt: skip
+        def diagnosed(arm: str, sample: GraphSample, d: Any) -> None:
+            session.diagnosed(arm, sample.t, sample, sample.fault, d)
+
+        reads_tracking = "pos_error" in load_profile(runtime.fleet.sensing).joint_channels
+        counts = run_monitor(cfg.ros2, runtime, cfg.duration_s or None, diagnosed, reads_tracking)
     for arm, c in counts.items():
         last = f" (last: {c['last_problem']})" if c["last_problem"] else ""
         print(f"{arm}: {c['samples']} samples diagnosed, {c['problems']} bad inputs, "
               f"{c['late']} late, {c['duplicates']} duplicate messages{last}")  # fmt: skip
-    if not cfg.evaluate:
-        return None
-    result = {arm: e.result() for arm, e in evaluators.items()}
-    out = evaluation_path(cfg.out, "online_eval_ros2.json")
-    atomic_write_json(out, {"model": runtime.describe(), "source": "ros2", "arms": result})
-    print(f"on-line evaluation of {len(result)} arms -> {out}")
-    return result
+    return session.finish()

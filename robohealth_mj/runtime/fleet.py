@@ -31,7 +31,7 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.arms.description import DEFAULT_ARM
-from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.errors import USER_ERRORS, InputError
 from robohealth_mj.common.numeric import joint_scores_from_logits, softmax
 from robohealth_mj.data.observability import MOVING_RAD_S, check_observability, hide_unobservable
 from robohealth_mj.data.sensing import load_profile
@@ -139,7 +139,10 @@ class FleetRuntime:
         providers: Sequence[str] | None = None,
         observability: str = "all",
         contact: ContactPolicy | None = None,
+        strict: bool = False,
     ) -> None:
+        """``strict``: a model named but missing or unusable raises (a command's user named
+        it) instead of leaving the runtime running without one (a library's caller)."""
         self.observability = check_observability(observability)
         self.contact_policy = contact or ContactPolicy()
         self.contact: ContactBank | None = None  # set by a model that carries thresholds
@@ -161,7 +164,7 @@ class FleetRuntime:
             import onnxruntime as ort
 
             providers = execution_providers(providers, ort.get_available_providers())
-        self._load(model_path, threads, incremental, capacity, providers)
+        self._load(model_path, threads, incremental, capacity, providers, strict)
         if self.engine is not None and observability == "motion":  # the model must read motion
             check_observability(observability, load_profile(self.sensing).joint_channels)
         self.alarms = AlarmBank(alarm or AlarmPolicy(), len(self.joints), capacity)
@@ -192,16 +195,24 @@ class FleetRuntime:
 
     def _load(
         self, model_path, threads: int, incremental: bool, capacity: int,
-        providers: Sequence[str] | None,
+        providers: Sequence[str] | None, strict: bool,
     ) -> None:  # fmt: skip
         if not model_path:
             self.problem = "no model configured"
         elif not Path(model_path).is_file():
+            if strict:
+                raise FileNotFoundError(f"{model_path}: no model file")
             self.problem = f"no model file at {model_path}"
         else:
             try:
                 self._open(Path(model_path), threads, incremental, capacity, providers)
-            except Exception as exc:  # a broken model must not take the monitor down
+            except Exception as exc:  # a broken model must not take a library's caller down
+                if strict and isinstance(exc, USER_ERRORS):
+                    raise
+                if strict:  # an old schema, a file onnxruntime cannot load: the user's to fix
+                    raise InputError(
+                        f"{model_path}: unusable ({type(exc).__name__}: {exc})"
+                    ) from exc
                 self.engine = None
                 self.problem = f"model {model_path} unusable: {type(exc).__name__}: {exc}"
         if self.engine is None:

@@ -1,11 +1,13 @@
-"""The monitor's loop over a simulated or replayed stream: each sample through the runtime, every
-change of diagnosis and every alarm printed, the topics and diagnoses optionally written to a bag,
-and with ``evaluate`` the on-line figures written beside the run (``python -m
-robohealth_mj.monitor``; the live ROS 2 loop is :func:`robohealth_mj.ros2.live.monitor_arms`)."""
+"""The monitor (``python -m robohealth_mj.monitor``): one session that takes each diagnosis,
+whatever the source: every change of diagnosis and every alarm printed, the topics and
+diagnoses optionally written to a bag, each stream's on-line evaluation and wear. A simulated or
+replayed stream is pulled through it here; live arms on the bus push into it
+(:func:`robohealth_mj.ros2.live.monitor_arms`)."""
 
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
 from contextlib import ExitStack
 from datetime import datetime
 from pathlib import Path
@@ -13,12 +15,11 @@ from pathlib import Path
 import numpy as np
 from omegaconf import DictConfig
 
-from robohealth_mj.bags import is_bag
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.bags.writer import BagWriter
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.data.read import recording_arm, recording_sensing
+from robohealth_mj.data.read import open_recording
 from robohealth_mj.data.sensing import refuse_missing_channels
 from robohealth_mj.prognostics.health import (
     Calibration,
@@ -27,10 +28,10 @@ from robohealth_mj.prognostics.health import (
 )
 from robohealth_mj.prognostics.rul import TrendRul
 from robohealth_mj.runtime.alarms import AlarmPolicy
+from robohealth_mj.runtime.contact import ContactPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.runtime.fleet import freeze_startup_heap
 from robohealth_mj.runtime.health import HealthTracker, health_fields
-from robohealth_mj.runtime.metadata import read_metadata
 from robohealth_mj.runtime.online_eval import OnlineEvaluator, joint_activity
 from robohealth_mj.runtime.online_report import online_markdown
 from robohealth_mj.runtime.runtime import HealthDiagnosis, ModelRuntime
@@ -49,9 +50,9 @@ def describe(d: HealthDiagnosis) -> str:
     return f"{contact}{d.fault_class} @ {d.localised_joint} (p={d.confidence:.2f})"
 
 
-def refuse_lacking_data(model: str, data_sensing: str, source: str) -> None:
+def refuse_lacking_data(model_sensing: str, data_sensing: str, source: str) -> None:
     """One line when the data lacks channels the exported model reads."""
-    refuse_missing_channels(read_metadata(model).get("sensing", "full"), data_sensing, source)
+    refuse_missing_channels(model_sensing, data_sensing, source)
 
 
 def refuse_other_arm(model_arm: str, data_arm: str | None, source: str) -> None:
@@ -64,74 +65,156 @@ def refuse_other_arm(model_arm: str, data_arm: str | None, source: str) -> None:
         )
 
 
+def monitor_policies(cfg: DictConfig) -> tuple[AlarmPolicy, EvidencePolicy, ContactPolicy]:
+    """The ``alarm``, ``evidence`` and ``contact`` blocks as their policies; a bad value is the
+    user's to fix, named by its block."""
+    built = []
+    for key, kind in (("alarm", AlarmPolicy), ("evidence", EvidencePolicy),
+                      ("contact", ContactPolicy)):  # fmt: skip
+        try:
+            built.append(kind(**cfg[key]))
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"conf/monitor.yaml {key}: {exc}") from None
+    return built[0], built[1], built[2]
+
+
+def pulled_source(cfg: DictConfig, runtime: ModelRuntime) -> Iterator[tuple]:
+    """``(t, sample, truth)`` from the simulator or a replayed recording (looked at once: its
+    kind, profile and arm), after refusing data the model cannot read."""
+    if cfg.source == "sim":
+        return sim_stream(list(cfg.sim_overrides), cfg.duration_s)
+    if cfg.source != "replay":
+        raise InputError(f"source must be sim, replay or ros2, got {cfg.source!r}")
+    if not cfg.file:
+        raise InputError("source=replay needs file=PATH to a graphs.jsonl, a bag directory or a "
+                         "controller log (.csv, .parquet), or file=sample")  # fmt: skip
+    recording = open_recording(cfg.file)
+    if runtime.fleet.engine is not None:
+        refuse_lacking_data(runtime.fleet.sensing, recording.sensing, cfg.file)
+        refuse_other_arm(runtime.arm, recording.arm, cfg.file)
+    return replay_stream(recording)
+
+
+def paced(stream: Iterator[tuple], speed: float) -> Iterator[tuple]:
+    """The stream at ``speed`` x the time its samples carry (0: as fast as it comes)."""
+    started, t0 = time.perf_counter(), None
+    for item in stream:
+        if speed and t0 is not None:
+            delay = (item[0] - t0) / speed - (time.perf_counter() - started)
+            if delay > 0:
+                time.sleep(delay)
+        t0 = item[0] if t0 is None else t0
+        yield item
+
+
 def monitor_stream(
     cfg: DictConfig, runtime: ModelRuntime, policy: AlarmPolicy, evidence: EvidencePolicy
 ) -> dict | None:
-    """Run the source through the runtime; with ``evaluate``, the on-line figures. Healthy ticks
-    count as settled once the window, the evidence and the alarm have had time to let a fault
-    go (``settle``)."""
-    if cfg.source == "sim":
-        stream = sim_stream(list(cfg.sim_overrides), cfg.duration_s)
-    elif cfg.source == "replay":
-        if not cfg.file or not (Path(cfg.file).is_file() or is_bag(cfg.file)):
-            raise FileNotFoundError(
-                f"source=replay needs file=PATH to a graphs.jsonl, a bag directory or a "
-                f"controller log (.csv, .parquet) (got {cfg.file})"
-            )
-        if cfg.model:
-            refuse_lacking_data(cfg.model, recording_sensing(cfg.file), cfg.file)
-            refuse_other_arm(runtime.arm, recording_arm(cfg.file), cfg.file)
-        stream = replay_stream(cfg.file)
-    else:
-        raise InputError(f"source must be sim, replay or ros2, got {cfg.source!r}")
+    """``source=sim`` or ``replay``: the source's samples pulled through the runtime into the
+    monitor's session, one stream (``stream_id``)."""
+    stream = pulled_source(cfg, runtime)
     freeze_startup_heap()
-    settle = runtime.window + policy.clear_after + evidence.clearing_ticks
-    evaluator = OnlineEvaluator(settle_ticks=settle, arm=runtime.arm) if cfg.evaluate else None
-    last, started, t0, valid = None, time.perf_counter(), None, 0
-    wear = (
-        SessionWear(cfg.stream_id, cfg.health) if cfg.get("health", {}).get("state_dir") else None
-    )
-    with ExitStack() as stack:
-        bag = stack.enter_context(BagWriter(cfg.bag_out)) if cfg.bag_out else None
-        for t, sample, truth in stream:
-            if cfg.speed and t0 is not None:
-                delay = (t - t0) / cfg.speed - (time.perf_counter() - started)
-                if delay > 0:
-                    time.sleep(delay)
-            t0 = t if t0 is None else t0
+    valid = 0
+    with MonitorSession(cfg, runtime, policy, evidence, print_changes=not cfg.quiet) as session:
+        for t, sample, truth in paced(stream, cfg.speed):
             valid += isinstance(sample, GraphSample)
-            d = runtime.process(cfg.stream_id, sample)
-            if bag is not None and isinstance(sample, GraphSample):
-                bag.write_sample(sample)
-                bag.write_diagnosis(d, runtime.fleet.classes, runtime.fleet.joints)
-            if evaluator is not None and truth is not None:
-                activity = joint_activity(sample.x) if isinstance(sample, GraphSample) else ()
-                evaluator.update(truth, d, *activity)
-            if not cfg.quiet:
-                last = print_change(cfg.stream_id, t, d, truth, last)
-            if wear is not None:
-                wear.add(d, runtime.fleet.joints)
+            session.diagnosed(
+                cfg.stream_id, t, sample, truth, runtime.process(cfg.stream_id, sample)
+            )
     if not valid:  # nothing was diagnosed: not a run to pass off as a healthy one
         raise InputError(f"{cfg.file or cfg.source}: no valid sample to diagnose")
-    if wear is not None:
-        wear.finish()
-    if cfg.bag_out:
-        print(f"replayed topics and {BagTopics.load().health_diagnosis} -> {cfg.bag_out}")
-    if evaluator is None:
-        return None
-    result = {
-        "model": runtime.describe(),
-        "source": cfg.source,
-        "file": cfg.file,
-        "alarm_policy": dict(cfg.alarm),
-        "evidence_policy": dict(cfg.evidence),
-        **evaluator.result(),
-    }
-    out = evaluation_path(cfg.out, "online_eval.json")
-    atomic_write_json(out, result)
-    atomic_write_text(out.with_suffix(".md"), online_markdown(result))
+    return session.finish()
+
+
+class MonitorSession:
+    """What the monitor does with each diagnosis, whatever the source (simulated, replayed or
+    live): print each change and alarm, write the topics and diagnoses to a bag, feed each
+    stream's on-line evaluation against its truth and its wear; when it ends, the wear into each
+    arm's health history and the evaluation into a file. The simulator and a replay are pulled
+    through it (:func:`monitor_stream`); live arms push into it
+    (:func:`robohealth_mj.ros2.live.monitor_arms`)."""
+
+    def __init__(
+        self, cfg: DictConfig, runtime: ModelRuntime, policy: AlarmPolicy,
+        evidence: EvidencePolicy, print_changes: bool = True, bag_out: str | None = None,
+    ) -> None:  # fmt: skip
+        self.cfg, self.runtime, self.print_changes = cfg, runtime, print_changes
+        self.settle = runtime.window + policy.clear_after + evidence.clearing_ticks
+        self.evaluators: dict[str, OnlineEvaluator] = {}
+        self.wear: dict[str, SessionWear] = {}
+        self.last: dict[str, str | None] = {}
+        health = cfg.get("health", {})
+        self.health = health if health.get("state_dir") else None
+        if self.health is not None and cfg.source != "ros2":
+            self.wear[cfg.stream_id] = SessionWear(cfg.stream_id, self.health)  # refused early
+        self._stack = ExitStack()
+        self.bag = self._stack.enter_context(BagWriter(cfg.bag_out)) if cfg.get("bag_out") else None
+
+    def __enter__(self) -> MonitorSession:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stack.close()
+
+    def diagnosed(
+        self, stream_id: str, t: float, sample: GraphSample | str, truth, d: HealthDiagnosis
+    ) -> None:
+        """One diagnosis of ``stream_id``'s sample (``truth``: its fault label, None unknown)."""
+        fleet = self.runtime.fleet
+        if self.bag is not None and isinstance(sample, GraphSample):
+            self.bag.write_sample(sample)
+            self.bag.write_diagnosis(d, fleet.classes, fleet.joints)
+        if self.cfg.evaluate and truth is not None:
+            if stream_id not in self.evaluators:
+                self.evaluators[stream_id] = OnlineEvaluator(
+                    settle_ticks=self.settle, arm=self.runtime.arm
+                )
+            activity = joint_activity(sample.x) if isinstance(sample, GraphSample) else ()
+            self.evaluators[stream_id].update(truth, d, *activity)
+        if self.print_changes:
+            self.last[stream_id] = print_change(stream_id, t, d, truth, self.last.get(stream_id))
+        if self.health is not None:
+            if stream_id not in self.wear:
+                self.wear[stream_id] = SessionWear(stream_id, self.health)
+            self.wear[stream_id].add(d, fleet.joints)
+
+    def finish(self) -> dict | None:
+        """Wear into each arm's history; the evaluation written (one stream: its figures; live
+        arms: per arm) and returned."""
+        for wear in self.wear.values():
+            wear.finish()
+        if self.bag is not None:
+            print(f"replayed topics and {BagTopics.load().health_diagnosis} -> {self.cfg.bag_out}")
+        if not self.cfg.evaluate:
+            return None
+        if self.cfg.source == "ros2":
+            result = {arm: e.result() for arm, e in self.evaluators.items()}
+            out = evaluation_path(self.cfg.out, "online_eval_ros2.json")
+            atomic_write_json(out, {"model": self.runtime.describe(), "source": "ros2",
+                                    "arms": result})  # fmt: skip
+            print(f"on-line evaluation of {len(result)} arms -> {out}")
+            return result
+        evaluator = self.evaluators.get(self.cfg.stream_id) or OnlineEvaluator(
+            settle_ticks=self.settle, arm=self.runtime.arm
+        )
+        result = {
+            "model": self.runtime.describe(),
+            "source": self.cfg.source,
+            "file": self.cfg.file,
+            "alarm_policy": dict(self.cfg.alarm),
+            "evidence_policy": dict(self.cfg.evidence),
+            **evaluator.result(),
+        }
+        out = evaluation_path(self.cfg.out, "online_eval.json")
+        atomic_write_json(out, result)
+        atomic_write_text(out.with_suffix(".md"), online_markdown(result))
+        print(summary_line(result, out))
+        return result
+
+
+def summary_line(result: dict, out: Path) -> str:
     alarms = result["alarms"]
-    print(
+    return (
         f"on-line accuracy {_num(result['online_accuracy'])}  localisation "
         f"{_num(result['localisation_accuracy'])} | alarms: detected "
         f"{alarms['detected']}/{alarms['episodes']} episodes, false alarms "
@@ -141,7 +224,6 @@ def monitor_stream(
         f"{_num(alarms['joint_latency_s_median'])} s (medians); contact calls "
         f"{result['contact_calls']} -> {out}"
     )
-    return result
 
 
 class SessionWear:

@@ -125,10 +125,11 @@ class ModelRuntime:
         evidence: EvidencePolicy | None = None,
         observability: str = "all",
         contact: ContactPolicy | None = None,
+        strict: bool = False,
     ) -> None:
         self.fleet = FleetRuntime(
             model_path, threads=threads, alarm=alarm, evidence=evidence, incremental=incremental,
-            observability=observability, contact=contact,
+            observability=observability, contact=contact, strict=strict,
         )  # fmt: skip
         self._queue: list[tuple[int, GraphSample]] = []
 

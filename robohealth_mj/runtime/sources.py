@@ -1,16 +1,15 @@
 """Where samples come from for the monitor and the simulated robot: the simulator itself, or a
-recording (graphs.jsonl or bag) replayed."""
+recording (graphs.jsonl, bag or controller log) replayed."""
 
 from __future__ import annotations
 
 import json
 from collections.abc import Iterator
 
-from robohealth_mj.bags import is_bag
-from robohealth_mj.bags.reader import read_bag_samples
 from robohealth_mj.common.config import compose_config
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.logs import is_log, log_samples
+from robohealth_mj.data.read import RecordingFile, open_recording
+from robohealth_mj.logs import log_samples
 from robohealth_mj.schema import FaultLabel, GraphSample, SchemaError, validate_sample
 
 
@@ -28,18 +27,25 @@ def sim_stream(
             yield t, sample, chunk.fault
 
 
-def replay_stream(path: str) -> Iterator[tuple[float, str | GraphSample, FaultLabel | None]]:
-    """``(t, sample, truth)`` per recorded sample: a graphs.jsonl's lines (a line that does not
-    parse goes to the runtime as it is, which flags it), a bag's assembled samples or a
-    controller log's ticks."""
-    if is_log(path):  # no ground truth: read as healthy, so evaluate counts false alarms
-        for sample in log_samples(path):
+def replay_stream(
+    recording: RecordingFile | str,
+) -> Iterator[tuple[float, str | GraphSample, FaultLabel | None]]:
+    """``(t, sample, truth)`` per recorded sample of a recording looked at once
+    (:func:`robohealth_mj.data.read.open_recording`): a graphs.jsonl's lines (a line that does
+    not parse goes to the runtime as it is, which flags it), a bag's assembled samples or a
+    controller log's ticks (no ground truth: read as healthy, so evaluate counts false alarms)."""
+    rec = open_recording(recording) if isinstance(recording, str) else recording
+    if rec.kind == "log":
+        for sample in log_samples(rec.path):
             yield sample.t, sample, sample.fault
         return
-    if is_bag(path):
-        for sample in read_bag_samples(path):
+    if rec.kind == "bag":
+        from robohealth_mj.bags.reader import read_bag_samples
+
+        for sample in read_bag_samples(rec.path):
             yield sample.t, sample, sample.fault
         return
+    path = rec.path
     with open(path, "rb") as handle:
         for number, raw in enumerate(handle, start=1):
             try:
@@ -50,7 +56,7 @@ def replay_stream(path: str) -> Iterator[tuple[float, str | GraphSample, FaultLa
                     "graphs.jsonl, a bag directory or a controller log (.csv, .parquet)"
                 ) from None
             try:
-                sample = validate_sample(json.loads(line), source=path, line=number)
+                sample = validate_sample(json.loads(line), source=str(path), line=number)
             except (ValueError, SchemaError):
                 yield 0.0, line, None
                 continue

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.version import code_version
 from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.twin_file import write_twin
@@ -110,3 +112,33 @@ def fidelity_table(rows: list[dict]) -> str:
     lines.append("NRMSE in % of the joint's range on that log; joints " + ", ".join(
         f"{s} = {j}" for s, j in zip(SHORT, JOINT_NAMES, strict=True)))  # fmt: skip
     return "\n".join(lines) + "\n"
+
+
+def cutoff_choice(value: Any) -> float | None:
+    """``cutoff_hz``: a frequency in Hz, or ``auto`` (None: chosen on the fit logs)."""
+    if value == "auto":
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        raise InputError(f"cutoff_hz: a frequency in Hz > 0 or auto, got {value!r}")
+    return float(value)
+
+
+def identification_summary(result: dict, arm: str, logs: int) -> str:
+    """What ``python -m robohealth_mj.identify`` prints: the fit, the velocity filter and how it
+    was chosen, each joint's drive, the fidelity table and the command that records on it."""
+    twin, fitted = result["twin"], result["twin"]["fit"]
+    tried = fitted.get("held_out_nrmse_by_cutoff_hz")
+    how = ("given" if tried is None else "chosen on the fit logs, mean NRMSE on one left out: "
+           + ", ".join(f"{c:g} Hz {100 * v:.2f} %" for c, v in tried.items()))  # fmt: skip
+    lines = [f"fitted on {fitted['seconds']:g} s of {logs} log(s) -> {result['twin_file']}",
+             f"  velocity low-pass {fitted['cutoff_hz']:g} Hz ({how})"]  # fmt: skip
+    k_t = twin["torque_constant_nm_per_a"]
+    for j, joint in enumerate(JOINT_NAMES):
+        d = twin["drive_overrides"][joint]
+        lines.append(f"  {joint:14s} armature {d['armature']:7.3f}  damping {d['damping']:7.3f}  "
+                     f"frictionloss {d['frictionloss']:7.3f}  k_t {k_t[j]:6.3f}")  # fmt: skip
+    if result["fidelity_md"]:
+        lines.append(result["fidelity_md"])
+    lines.append(f"record on it: python -m robohealth_mj.record arm={arm} "
+                 f"sim.twin={result['twin_file']}")  # fmt: skip
+    return "\n".join(lines)

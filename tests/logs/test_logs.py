@@ -15,6 +15,7 @@ from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.read import read_samples, recording_sensing
 from robohealth_mj.ingest import main as ingest_main
 from robohealth_mj.logs.convert import convert_log
+from robohealth_mj.logs.rtde_writer import write_rtde_csv
 
 J = schema.N_JOINTS
 K_T = np.array([11.0, 11.5, 9.0, 4.2, 4.0, 3.8])  # N*m per A the tests' "controller" uses
@@ -205,18 +206,7 @@ def test_each_bad_log_gets_one_line_naming_file_column_and_line(tmp_path, capsys
 
 def _as_rtde_log(x: np.ndarray, index: np.ndarray, path: Path, k_t: np.ndarray = K_T) -> Path:
     """A UR RTDE CSV carrying snapshots' ``[T, 12, F]`` joint channels at their 20 Hz ticks."""
-    x = x[:, :J].astype(np.float64)
-    pos, vel, effort, err, residual = (
-        x[..., schema.feature_index(n)] for n in schema.STATE_FEATURES
-    )
-    cols = {"timestamp": 0.05 * index.astype(np.float64)}
-    for j in range(J):
-        cols[f"actual_q_{j}"], cols[f"target_q_{j}"] = pos[:, j], pos[:, j] - err[:, j]
-        cols[f"actual_qd_{j}"] = vel[:, j]
-        cols[f"actual_current_{j}"] = effort[:, j] / k_t[j]
-        cols[f"target_current_{j}"] = (effort[:, j] - residual[:, j]) / k_t[j]
-        cols[f"target_moment_{j}"] = effort[:, j] - residual[:, j]
-    return _write_csv(path, cols, ",")
+    return write_rtde_csv(x, 0.05 * index.astype(np.float64), path, k_t)
 
 
 def test_a_stock_model_diagnoses_a_log_as_it_diagnoses_the_recording(

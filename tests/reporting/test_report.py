@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robohealth_mj.report import build_report
+from robohealth_mj.reporting.build import build_report
 from robohealth_mj.schema import FAULT_CLASSES
 
 
