@@ -1,15 +1,18 @@
-"""Arm descriptions: one UR e-Series arm as data, read from ``assets/<arm>/``.
+"""Arm descriptions: a serial arm of any joint count as data, read from ``assets/<arm>/``.
 
-UR's own parameter files (``ur_description/``, copied verbatim from UR's ROS 2 description
-package) give the kinematics, the link inertials and the joint limits; ``arm.yaml`` adds what
-they lack (rated payload, reach, UR's DH table for the independent checks). Light on purpose
-(numpy and yaml only): the torch- and MuJoCo-free runtime reads an arm's ratings from here.
+A UR e-Series arm: UR's own parameter files (``ur_description/``, copied verbatim from UR's ROS 2
+description package) give the kinematics, the link inertials and the joint limits; ``arm.yaml``
+adds what they lack (rated payload, reach, UR's DH table for the independent checks). Any other
+arm: ``arm.yaml`` alone, this project's own file written from the maker's published numbers
+(``joints:``, base to tool: each joint's frame, limits and the link it moves), its provenance in
+the folder's README. Light on purpose (numpy and yaml only): the torch- and MuJoCo-free runtime
+reads an arm's ratings from here.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -51,17 +54,25 @@ class ArmDescription:
     """Everything the builder, the curriculum and the ratings need about one arm."""
 
     name: str
-    links: tuple[Link, ...]  # in schema joint order
+    links: tuple[Link, ...]  # J links, base to tool (joint j moves link j)
     base_mass: float
     base_radius: float
     base_length: float
-    rated_torque: np.ndarray  # [6] N m (UR's max_effort)
-    speed_limit: np.ndarray  # [6] rad/s
-    position_limit: np.ndarray  # [6, 2] rad
+    rated_torque: np.ndarray  # [J] N m (the maker's effort limit)
+    speed_limit: np.ndarray  # [J] rad/s
+    position_limit: np.ndarray  # [J, 2] rad
     payload_kg: float
     reach_m: float
-    dh: dict[str, np.ndarray]  # d, a, alpha [6]; mass [6]; com [6, 3] (UR's DH table)
+    dh: dict[str, np.ndarray] | None  # UR's DH table (d, a, alpha, mass [6]; com [6, 3]) or None
     source: Path
+    joint_names: tuple[str, ...] = ()  # the driver's joint names, base to tool
+    maker: str = "Universal Robots"
+    torque_sensors: bool = False  # a torque sensor in every joint, reported by the controller
+    flange_xyz: np.ndarray = field(default_factory=lambda: np.zeros(3))  # in the last link
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.links)
 
     def ratings(self) -> dict[str, Any]:
         """The arm's identity and ratings, as manifests and checkpoints carry them."""
@@ -135,7 +146,63 @@ def load_arm(name: str = DEFAULT_ARM) -> ArmDescription:
     folder = asset_dir() / str(name)
     if not (folder / "arm.yaml").is_file():
         raise InputError(f"unknown arm {name!r}; known: {', '.join(known_arms())}")
+    if not (folder / "ur_description").is_dir():
+        return _load_chain(folder, str(name))
     return _load(folder, str(name))
+
+
+_INERTIA = ("xx", "yy", "zz", "xy", "xz", "yz")
+
+
+@cache
+def _load_chain(folder: Path, name: str) -> ArmDescription:
+    """An arm described by this project's own ``arm.yaml`` (``joints:``, base to tool)."""
+    path = folder / "arm.yaml"
+    data = _read(path)
+    joints = _field(data, path, "joints")
+    if not isinstance(joints, list) or not joints:
+        raise InputError(f"{path}: field joints needs a list, base to tool")
+    links, limits = [], []
+    for k, joint in enumerate(joints):
+        where = ("joints", str(k))
+        if not isinstance(joint, dict):
+            raise InputError(f"{path}: field joints.{k} needs a mapping")
+        item = {"joints": {str(k): joint}}
+        i = {c: _number(item, path, *where, "inertia", c) for c in _INERTIA}
+        links.append(Link(
+            origin_xyz=_vector(item, path, *where, "origin_xyz", n=3),
+            origin_rpy=_vector(item, path, *where, "origin_rpy", n=3),
+            mass=_number(item, path, *where, "mass"),
+            com=_vector(item, path, *where, "com", n=3),
+            inertia_rpy=np.zeros(3),
+            inertia=np.array([[i["xx"], i["xy"], i["xz"]], [i["xy"], i["yy"], i["yz"]],
+                              [i["xz"], i["yz"], i["zz"]]]),
+        ))  # fmt: skip
+        limits.append([_number(item, path, *where, "limit", c)
+                       for c in ("lower", "upper", "velocity", "effort")])  # fmt: skip
+    lim = np.array(limits)
+    names = tuple(str(n) for n in _field(data, path, "joint_names"))
+    if len(names) != len(links):
+        raise InputError(f"{path}: field joint_names needs {len(links)} names, one per joint")
+    desc = ArmDescription(
+        name=str(_field(data, path, "name")),
+        links=tuple(links),
+        base_mass=_number(data, path, "base", "mass"),
+        base_radius=0.0,
+        base_length=0.0,
+        rated_torque=lim[:, 3],
+        speed_limit=lim[:, 2],
+        position_limit=lim[:, :2],
+        payload_kg=_number(data, path, "payload_kg"),
+        reach_m=_number(data, path, "reach_m"),
+        dh=None,
+        source=folder,
+        joint_names=names,
+        maker=str(_field(data, path, "maker")),
+        torque_sensors=bool(data.get("torque_sensors", False)),
+        flange_xyz=_vector(data, path, "flange_xyz", n=3),
+    )
+    return _checked(desc, name, path, path)
 
 
 @cache
@@ -197,14 +264,24 @@ def _load(folder: Path, name: str) -> ArmDescription:
             "com": _vector(ours, dh_path, "dh", "com", n=6),
         },
         source=folder,
+        joint_names=tuple(f"{j}_joint" for j in JOINT_NAMES),  # the UR driver's
     )
-    if desc.name != name:
-        raise InputError(f"{dh_path}: field name is {desc.name!r}, the folder says {name!r}")
-    if desc.dh["com"].shape != (6, 3):
+    if desc.dh is not None and desc.dh["com"].shape != (6, 3):
         raise InputError(f"{dh_path}: field dh.com needs 6 rows of 3 values")
-    for what, values in (("max_effort", desc.rated_torque), ("max_velocity", desc.speed_limit)):
+    return _checked(desc, name, dh_path, lim_path)
+
+
+def _checked(desc: ArmDescription, name: str, path: Path, lim_path: Path) -> ArmDescription:
+    """What every description must satisfy, whoever wrote it."""
+    if desc.name != name:
+        raise InputError(f"{path}: field name is {desc.name!r}, the folder says {name!r}")
+    for what, values in (("effort", desc.rated_torque), ("velocity", desc.speed_limit)):
         if np.any(values <= 0):
-            raise InputError(f"{lim_path}: every joint's {what} must be positive")
+            raise InputError(f"{lim_path}: every joint's {what} limit must be positive")
+    if np.any(desc.position_limit[:, 0] >= desc.position_limit[:, 1]):
+        raise InputError(f"{lim_path}: every joint's lower limit must lie below its upper")
+    if any(link.mass <= 0 for link in desc.links):
+        raise InputError(f"{path}: every link's mass must be positive")
     if desc.payload_kg <= 0 or desc.reach_m <= 0:
-        raise InputError(f"{dh_path}: payload_kg and reach_m must be positive")
+        raise InputError(f"{path}: payload_kg and reach_m must be positive")
     return desc

@@ -65,6 +65,19 @@ POSES = {
 }
 
 
+@pytest.mark.parametrize("arm", ARMS)
+def test_the_description_chain_gives_urs_dh_table_gravity(arm):
+    """arms/chain.py (URDF frames, any joint count) against UR's DH table on every UR arm."""
+    from robohealth_mj.arms.chain import gravity_torques as chain_gravity_torques
+
+    ur = load_arm(arm)
+    for q in POSES.values():
+        for payload in (0.0, ur.payload_kg):
+            ours = chain_gravity_torques(ur, np.array(q), payload)
+            theirs = dh_gravity_torques(ur.dh, np.array(q), payload)
+            assert np.max(np.abs(ours - theirs)) <= 1e-6 * np.max(np.abs(theirs))
+
+
 def test_the_e_series_arms_ship():
     assert set(ARMS) <= set(known_arms())
 

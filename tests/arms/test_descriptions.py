@@ -1,0 +1,92 @@
+"""Arms of any joint count as data: the seven-joint FR3 read from this project's own description,
+its gravity torques from the description's chain (URDF frames) against an independent
+computation from the maker's other publication of the same arm (Franka's DH table, Craig's
+convention). The chain code is checked on every UR arm against UR's DH table in
+tests/sim/test_arms.py."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robohealth_mj.arms.chain import GRAVITY, gravity_torques
+from robohealth_mj.arms.description import load_arm
+from robohealth_mj.common.errors import InputError
+
+# Franka's published DH table of the FR3 (frankaemika.github.io/docs, "Denavit-Hartenberg
+# parameters", Craig's convention): a_{i-1}, d_i, alpha_{i-1} per joint, then the flange.
+FR3_DH = {
+    "a": [0.0, 0.0, 0.0, 0.0825, -0.0825, 0.0, 0.088, 0.0],
+    "d": [0.333, 0.0, 0.316, 0.0, 0.384, 0.0, 0.0, 0.107],
+    "alpha": [0.0, -np.pi / 2, np.pi / 2, np.pi / 2, -np.pi / 2, np.pi / 2, np.pi / 2, 0.0],
+}
+POSES = {
+    "ready": [0.0, -np.pi / 4, 0.0, -3 * np.pi / 4, 0.0, np.pi / 2, np.pi / 4],
+    "stretched": [0.0, 1.2, 0.0, -0.3, 0.0, 1.5, 0.0],
+    "twisted": [0.8, -0.6, 1.1, -2.0, -1.4, 2.2, -0.7],
+    "folded": [-1.5, 1.5, -2.0, -2.8, 2.0, 0.8, 2.5],
+}
+
+
+def craig_frames(dh: dict, q: np.ndarray) -> list[np.ndarray]:
+    """Base -> frame i (i = 1..7, then the flange), modified DH: Rx(alpha) Tx(a) Rz(q) Tz(d)."""
+    frames, current = [], np.eye(4)
+    for i, (a, d, alpha) in enumerate(zip(dh["a"], dh["d"], dh["alpha"], strict=True)):
+        angle = q[i] if i < len(q) else 0.0
+        ca, sa, ct, st = np.cos(alpha), np.sin(alpha), np.cos(angle), np.sin(angle)
+        step = np.array([
+            [ct, -st, 0.0, a],
+            [st * ca, ct * ca, -sa, -sa * d],
+            [st * sa, ct * sa, ca, ca * d],
+            [0.0, 0.0, 0.0, 1.0],
+        ])  # fmt: skip
+        current = current @ step
+        frames.append(current)
+    return frames
+
+
+def craig_gravity_torques(arm, q: np.ndarray, payload_kg: float = 0.0) -> np.ndarray:
+    """The holding torques from Franka's DH frames (the link frames the inertials are given in)."""
+    frames = craig_frames(FR3_DH, q)
+    points = [
+        (f @ np.append(link.com, 1.0))[:3] for f, link in zip(frames[:7], arm.links, strict=True)
+    ]
+    points.append(frames[-1][:3, 3])
+    masses = [link.mass for link in arm.links] + [payload_kg]
+    tau = np.zeros(7)
+    for j in range(7):
+        axis, origin = frames[j][:3, 2], frames[j][:3, 3]
+        for m, p in zip(masses[j:], points[j:], strict=True):
+            tau[j] += m * GRAVITY * np.cross(axis, p - origin)[2]
+    return tau
+
+
+def test_the_fr3_is_seven_joints_with_its_drivers_names_and_ratings():
+    fr3 = load_arm("fr3")
+    assert fr3.n_joints == 7 and fr3.maker == "Franka Robotics" and fr3.torque_sensors
+    assert fr3.joint_names == tuple(f"fr3_joint{k}" for k in range(1, 8))
+    np.testing.assert_array_equal(fr3.rated_torque, [87, 87, 87, 87, 12, 12, 12])
+    np.testing.assert_array_equal(fr3.speed_limit, [2.62, 2.62, 2.62, 2.62, 5.26, 4.18, 5.26])
+    assert fr3.payload_kg == 3.0 and sum(link.mass for link in fr3.links) == pytest.approx(
+        15.49, abs=0.01
+    )
+
+
+@pytest.mark.parametrize("pose", POSES)
+@pytest.mark.parametrize("payload", [0.0, 3.0])
+def test_fr3_gravity_torques_agree_with_frankas_dh_table(pose, payload):
+    fr3 = load_arm("fr3")
+    q = np.array(POSES[pose])
+    ours, theirs = gravity_torques(fr3, q, payload), craig_gravity_torques(fr3, q, payload)
+    assert np.max(np.abs(ours - theirs)) <= 0.005 * np.max(np.abs(theirs))
+    assert np.max(np.abs(theirs)) > 5.0  # a pose that loads the arm, not a trivial zero
+
+
+def test_a_description_with_a_bad_field_is_one_line_naming_it(tmp_path, monkeypatch):
+    arm = tmp_path / "myarm"
+    arm.mkdir()
+    text = (load_arm("fr3").source / "arm.yaml").read_text().replace("name: fr3", "name: myarm")
+    (arm / "arm.yaml").write_text(text.replace("mass: 2.9274653454", "mass: heavy", 1))
+    monkeypatch.setenv("ROBOHEALTH_ASSETS", str(tmp_path))
+    with pytest.raises(InputError, match=r"arm.yaml: field joints.0.mass is not a number"):
+        load_arm("myarm")
