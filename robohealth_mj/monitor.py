@@ -34,6 +34,7 @@ def run(cfg: DictConfig) -> dict | None:
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     with one_line_errors("monitor"):
         cfg.model, cfg.file = resolve_model(cfg.model), resolve_file(cfg.file)  # model=stock
+        cfg.source = cfg.source or ("replay" if cfg.file else "sim")
         alarm, evidence, contact = monitor_policies(cfg)
         runtime = ModelRuntime(
             cfg.model,

@@ -100,7 +100,7 @@ def wheel(tmp_path_factory) -> Path:
     out, source = tmp_path_factory.mktemp("wheel"), tmp_path_factory.mktemp("source")
     for name in ("pyproject.toml", "setup.py", "README.md", "LICENSE", "NOTICE"):  # a build writes
         shutil.copy2(REPO / name, source / name)  # beside its source: build from a copy
-    for name in ("robohealth_mj", "conf", "assets"):
+    for name in ("robohealth_mj", "conf", "assets", "ready_models"):
         shutil.copytree(REPO / name, source / name, ignore=shutil.ignore_patterns("__pycache__"))
     done = subprocess.run(
         [sys.executable, "-m", "pip", "wheel", str(source), "--no-deps", "--no-build-isolation",
@@ -168,6 +168,33 @@ def test_the_installed_wheel_records_from_an_empty_directory(wheel, tmp_path):
     assert f"package: {site}" in done.stdout
     (manifest,) = (empty / "outputs" / "record").glob("*/manifest.json")
     assert json.loads(manifest.read_text())["sample_count"] == 20
+
+
+def test_the_installed_monitor_diagnoses_the_sample_with_a_ready_model(wheel, tmp_path):
+    """``pip install 'robohealth_mj[monitor]'`` then one command, in an empty directory, with
+    the simulator and the training stack out of reach: the stock model, by name, diagnoses the
+    shipped sample log; the names are in the wheel with their cards."""
+    names = set(zipfile.ZipFile(wheel).namelist())
+    for name in ("full", "stock", "ur_driver"):
+        assert {f"robohealth_mj/ready_models/{name}.{ext}" for ext in ("onnx", "md")} <= names
+    site = tmp_path / "site"
+    done = subprocess.run(
+        [sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-compile",
+         "--target", str(site), str(wheel)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    empty = tmp_path / "work"
+    empty.mkdir()
+    env = {**os.environ, "PYTHONPATH": str(site), "PYTHONUNBUFFERED": "1"}
+    done = subprocess.run(
+        [sys.executable, "-c", _BLOCKER + "import runpy, sys\nsys.argv[0] = 'monitor'\n"
+         "runpy.run_module('robohealth_mj.monitor', run_name='__main__')",
+         "model=stock", "file=sample"],
+        cwd=empty, env=env, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    assert ": friction @" in done.stdout and list(empty.iterdir()) == []
 
 
 def _imports(path: Path) -> list[tuple[str, list[str], int]]:
@@ -263,10 +290,10 @@ def test_layers_point_one_way():
     assert upward == []
 
 
-def test_the_package_root_holds_the_entry_points_and_the_schema_only():
+def test_the_package_root_holds_the_entry_points_only():
     library = [
         p.name
         for p in PACKAGE.glob("*.py")
-        if p.stem not in ("__init__", "schema") and '__name__ == "__main__"' not in p.read_text()
+        if p.stem != "__init__" and '__name__ == "__main__"' not in p.read_text()
     ]
     assert library == []

@@ -78,11 +78,12 @@ def monitor_policies(cfg: DictConfig) -> tuple[AlarmPolicy, EvidencePolicy, Cont
     return built[0], built[1], built[2]
 
 
-def pulled_source(cfg: DictConfig, runtime: ModelRuntime) -> Iterator[tuple]:
+def pulled_source(cfg: DictConfig, runtime: ModelRuntime) -> tuple[Iterator[tuple], bool]:
     """``(t, sample, truth)`` from the simulator or a replayed recording (looked at once: its
-    kind, profile and arm), after refusing data the model cannot read."""
+    kind, profile and arm), after refusing data the model cannot read; and whether its truth is
+    known (a controller log has none: read as healthy, it counts false alarms, never shown)."""
     if cfg.source == "sim":
-        return sim_stream(list(cfg.sim_overrides), cfg.duration_s)
+        return sim_stream(list(cfg.sim_overrides), cfg.duration_s), True
     if cfg.source != "replay":
         raise InputError(f"source must be sim, replay or ros2, got {cfg.source!r}")
     if not cfg.file:
@@ -92,7 +93,7 @@ def pulled_source(cfg: DictConfig, runtime: ModelRuntime) -> Iterator[tuple]:
     if runtime.fleet.engine is not None:
         refuse_lacking_data(runtime.fleet.sensing, recording.sensing, cfg.file)
         refuse_other_arm(runtime.arm, recording.arm, cfg.file)
-    return replay_stream(recording)
+    return replay_stream(recording), recording.kind != "log"
 
 
 def paced(stream: Iterator[tuple], speed: float) -> Iterator[tuple]:
@@ -112,10 +113,11 @@ def monitor_stream(
 ) -> dict | None:
     """``source=sim`` or ``replay``: the source's samples pulled through the runtime into the
     monitor's session, one stream (``stream_id``)."""
-    stream = pulled_source(cfg, runtime)
+    stream, labelled = pulled_source(cfg, runtime)
     freeze_startup_heap()
     valid = 0
-    with MonitorSession(cfg, runtime, policy, evidence, print_changes=not cfg.quiet) as session:
+    shown = not cfg.quiet
+    with MonitorSession(cfg, runtime, policy, evidence, shown, labelled) as session:
         for t, sample, truth in paced(stream, cfg.speed):
             valid += isinstance(sample, GraphSample)
             session.diagnosed(
@@ -136,9 +138,10 @@ class MonitorSession:
 
     def __init__(
         self, cfg: DictConfig, runtime: ModelRuntime, policy: AlarmPolicy,
-        evidence: EvidencePolicy, print_changes: bool = True, bag_out: str | None = None,
+        evidence: EvidencePolicy, print_changes: bool = True, labelled: bool = True,
     ) -> None:  # fmt: skip
         self.cfg, self.runtime, self.print_changes = cfg, runtime, print_changes
+        self.labelled = labelled  # the source's truth is known, so printed beside each change
         self.settle = runtime.window + policy.clear_after + evidence.clearing_ticks
         self.evaluators: dict[str, OnlineEvaluator] = {}
         self.wear: dict[str, SessionWear] = {}
@@ -172,7 +175,8 @@ class MonitorSession:
             activity = joint_activity(sample.x) if isinstance(sample, GraphSample) else ()
             self.evaluators[stream_id].update(truth, d, *activity)
         if self.print_changes:
-            self.last[stream_id] = print_change(stream_id, t, d, truth, self.last.get(stream_id))
+            shown = truth if self.labelled else None
+            self.last[stream_id] = print_change(stream_id, t, d, shown, self.last.get(stream_id))
         if self.health is not None:
             if stream_id not in self.wear:
                 self.wear[stream_id] = SessionWear(stream_id, self.health)

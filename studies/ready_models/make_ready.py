@@ -49,6 +49,14 @@ PROFILES = {
 }
 
 
+USE = {  # the one command that runs each on what it reads
+    "full": "python -m robohealth_mj.monitor model=full file=graphs.jsonl",
+    "stock": "python -m robohealth_mj.monitor model=stock file=sample   # or file=YOUR_LOG.csv",
+    "ur_driver": "python -m robohealth_mj.monitor model=ur_driver source=ros2 "
+    "ros2.layout=ur_driver",
+}
+
+
 def _metrics(run: Path, name: str) -> dict:
     return json.loads((run / f"eval_{name}.json").read_text())["metrics"]
 
@@ -57,8 +65,8 @@ def _card(name: str, run: Path, meta: dict) -> str:
     reads, feeds = PROFILES[name]
     held, probe = _metrics(run, "heldout"), _metrics(run, "probe")
     row = "| {} | {:.3f} | {:.3f} | {:.3f} |"
-    classes = ", ".join(json.loads(meta["classes"]) if isinstance(meta["classes"], str)
-                        else meta["classes"])  # fmt: skip
+    labels = meta.get("label_set", meta["classes"])  # what the profile's channels can see
+    classes = ", ".join(json.loads(labels) if isinstance(labels, str) else labels)
     return "\n".join(
         [
             f"# Ready model `{name}` ({meta['variant']}, W = {meta['window']})",
@@ -99,11 +107,7 @@ def _card(name: str, run: Path, meta: dict) -> str:
             "",
             "## Use it",
             "```",
-            f"python -m robohealth_mj.monitor model={name} source=replay file=sample"
-            if name == "stock"
-            else f"python -m robohealth_mj.monitor model={name} source=ros2 ros2.layout=ur_driver"
-            if name == "ur_driver"
-            else f"python -m robohealth_mj.monitor model={name} source=replay file=graphs.jsonl",
+            USE[name],
             "```",
             "",
             "## Commission it on your arm",
@@ -127,23 +131,31 @@ def _card(name: str, run: Path, meta: dict) -> str:
 
 
 def _sample(corpus: Path) -> str:
-    """A minute of the held-out session around a fault's onset, as a UR RTDE log."""
-    rec = load_recordings([corpus / "heldout_seed900"])
+    """A minute of the held-out session from 20 s before a fault's onset, as a UR RTDE log; the
+    faults it holds, as the recording's labels give them (the log itself carries none)."""
+    rec = load_recordings([corpus / "heldout_seed900" / "graphs.jsonl"])
     first = np.flatnonzero(rec.run == 0)
-    active = rec.active[first]
-    mechanical = np.isin(rec.fault_class[first], [FAULT_CLASSES.index("friction")])
-    onset = int(np.flatnonzero(active & mechanical)[0])
-    start = max(onset - int(20.0 / TICK_S), 0)
+    friction = rec.active[first] & (rec.fault_class[first] == FAULT_CLASSES.index("friction"))
+    start = max(int(np.flatnonzero(friction)[0]) - int(20.0 / TICK_S), 0)
     picked = first[start : start + int(SAMPLE_S / TICK_S)]
     t = TICK_S * (rec.sample_index[picked] - rec.sample_index[picked[0]])
     write_rtde_csv(rec.x[picked], t, READY / SAMPLE_FILE)
-    joint = JOINT_NAMES[int(rec.fault_joint[first][onset])]
-    severity = float(rec.severity[first][onset])
-    return (
-        f"- `{SAMPLE_FILE}`: {SAMPLE_S:g} s of the held-out session (seed 900) of the "
-        f"nominal UR5e as a UR RTDE log; healthy for 20 s, then friction at the {joint} "
-        f"(severity {severity:.2f}) from t = 20 s. `file=sample` names it."
-    )
+    episodes, k = [], 0
+    while k < len(picked):
+        if not rec.active[picked[k]]:
+            k += 1
+            continue
+        end = k
+        while end + 1 < len(picked) and rec.active[picked[end + 1]]:
+            end += 1
+        i = picked[k]
+        episodes.append(f"{FAULT_CLASSES[rec.fault_class[i]]} at the "
+                        f"{JOINT_NAMES[rec.fault_joint[i]]} (severity {rec.severity[i]:.2f}) "
+                        f"{t[k]:.0f}-{t[end] + TICK_S:.0f} s")  # fmt: skip
+        k = end + 1
+    return (f"- `{SAMPLE_FILE}`: {SAMPLE_S:g} s of the held-out session (seed 900) of the "
+            f"nominal UR5e as a UR RTDE log, healthy but for: {'; '.join(episodes)}. "
+            "`file=sample` names it.")  # fmt: skip
 
 
 def main(runs: Path, corpus: Path) -> None:
