@@ -1,6 +1,6 @@
 """An arm's kinematic chain in plain numpy, from its description alone (URDF convention: each
 joint's frame placed in its parent link's by ``origin_xyz`` and roll-pitch-yaw, then turned by
-the joint angle about its z axis).
+the joint angle about its axis, z unless the description says otherwise).
 
 Why here and not in MuJoCo: it is the computation the simulator is checked against (gravity
 torques from the maker's numbers, sharing no code with the builder), and it serves any joint
@@ -26,6 +26,13 @@ def rotation_rpy(rpy: np.ndarray) -> np.ndarray:
     ])  # fmt: skip
 
 
+def rotation_about(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rodrigues: the rotation by ``angle`` about the unit ``axis``."""
+    x, y, z = axis
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
+
+
 def link_frames(arm: ArmDescription, q: np.ndarray) -> list[np.ndarray]:
     """``[J]`` homogeneous transforms base -> link j at the joint angles ``q`` ``[J]``."""
     frames, current = [], np.eye(4)
@@ -33,7 +40,7 @@ def link_frames(arm: ArmDescription, q: np.ndarray) -> list[np.ndarray]:
         place = np.eye(4)
         place[:3, :3], place[:3, 3] = rotation_rpy(link.origin_rpy), link.origin_xyz
         turn = np.eye(4)
-        turn[:3, :3] = rotation_rpy(np.array([0.0, 0.0, angle]))
+        turn[:3, :3] = rotation_about(link.axis, angle)
         current = current @ place @ turn
         frames.append(current)
     return frames
@@ -47,8 +54,8 @@ def gravity_torques(arm: ArmDescription, q: np.ndarray, payload_kg: float = 0.0)
     points = [(f @ np.append(link.com, 1.0))[:3] for f, link in zip(frames, arm.links, strict=True)]
     points.append((frames[-1] @ np.append(arm.flange_xyz, 1.0))[:3])
     tau = np.zeros(arm.n_joints)
-    for j, frame in enumerate(frames):
-        axis, origin = frame[:3, 2], frame[:3, 3]
+    for j, (frame, link) in enumerate(zip(frames, arm.links, strict=True)):
+        axis, origin = frame[:3, :3] @ link.axis, frame[:3, 3]
         for m, p in zip(masses[j:], points[j:], strict=True):  # what joint j carries
             tau[j] += m * GRAVITY * np.cross(axis, p - origin)[2]
     return tau

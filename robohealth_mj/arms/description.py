@@ -39,7 +39,8 @@ _Loader.add_constructor("!degrees", lambda loader, node: math.radians(float(node
 
 @dataclass(frozen=True)
 class Link:
-    """One link's inertial as UR's description gives it, in the URDF link frame."""
+    """One link and the joint that moves it, as the maker's description gives them (URDF
+    frames)."""
 
     origin_xyz: np.ndarray  # [3] the joint moving this link, in the parent link's frame
     origin_rpy: np.ndarray  # [3] URDF roll, pitch, yaw of that joint frame
@@ -47,6 +48,7 @@ class Link:
     com: np.ndarray  # [3] centre of mass in the link frame
     inertia_rpy: np.ndarray  # [3] orientation of the inertia frame
     inertia: np.ndarray  # [3, 3] inertia tensor about the com, in the inertia frame
+    axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))  # joint axis
 
 
 @dataclass(frozen=True)
@@ -154,6 +156,17 @@ def load_arm(name: str = DEFAULT_ARM) -> ArmDescription:
 _INERTIA = ("xx", "yy", "zz", "xy", "xz", "yz")
 
 
+def _axis(item: dict, path: Path, *where: str) -> np.ndarray:
+    """A joint's unit axis in its frame (``axis``, default z, as URDF's)."""
+    if "axis" not in _field(item, path, *where):
+        return np.array([0.0, 0.0, 1.0])
+    axis = _vector(item, path, *where, "axis", n=3)
+    norm = float(np.linalg.norm(axis))
+    if not norm:
+        raise InputError(f"{path}: field {'.'.join(where)}.axis is the zero vector")
+    return axis / norm
+
+
 @cache
 def _load_chain(folder: Path, name: str) -> ArmDescription:
     """An arm described by this project's own ``arm.yaml`` (``joints:``, base to tool)."""
@@ -177,6 +190,7 @@ def _load_chain(folder: Path, name: str) -> ArmDescription:
             inertia_rpy=np.zeros(3),
             inertia=np.array([[i["xx"], i["xy"], i["xz"]], [i["xy"], i["yy"], i["yz"]],
                               [i["xz"], i["yz"], i["zz"]]]),
+            axis=_axis(item, path, *where),
         ))  # fmt: skip
         limits.append([_number(item, path, *where, "limit", c)
                        for c in ("lower", "upper", "velocity", "effort")])  # fmt: skip

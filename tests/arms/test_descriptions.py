@@ -90,3 +90,61 @@ def test_a_description_with_a_bad_field_is_one_line_naming_it(tmp_path, monkeypa
     monkeypatch.setenv("ROBOHEALTH_ASSETS", str(tmp_path))
     with pytest.raises(InputError, match=r"arm.yaml: field joints.0.mass is not a number"):
         load_arm("myarm")
+
+
+def _urdf(arm, payload_kg: float) -> str:
+    """The description as a URDF (the maker's own format), for MuJoCo's URDF importer: a second
+    computation of the same published numbers, through code that shares nothing with ours."""
+
+    def inertial(mass, com, inertia) -> str:
+        i = inertia
+        moments = (f'ixx="{i[0, 0]}" iyy="{i[1, 1]}" izz="{i[2, 2]}" ixy="{i[0, 1]}" '
+                   f'ixz="{i[0, 2]}" iyz="{i[1, 2]}"')  # fmt: skip
+        return (f'<inertial><origin xyz="{" ".join(map(str, com))}" rpy="0 0 0"/>'
+                f'<mass value="{mass}"/><inertia {moments}/></inertial>')  # fmt: skip
+
+    base = inertial(1.0, [0, 0, 0], np.eye(3) * 1e-3)
+    parts = ['<robot name="arm"><mujoco><compiler balanceinertia="true" discardvisual="true"/>'
+             f'</mujoco><link name="l0">{base}</link>']  # fmt: skip
+    for k, link in enumerate(arm.links, start=1):
+        parts.append(f'<link name="l{k}">{inertial(link.mass, link.com, link.inertia)}</link>')
+        parts.append(
+            f'<joint name="j{k}" type="revolute"><parent link="l{k - 1}"/><child link="l{k}"/>'
+            f'<origin xyz="{" ".join(map(str, link.origin_xyz))}" '
+            f'rpy="{" ".join(map(str, link.origin_rpy))}"/>'
+            f'<axis xyz="{" ".join(map(str, link.axis))}"/>'
+            '<limit lower="-10" upper="10" effort="1000" velocity="10"/></joint>'
+        )
+    if payload_kg:
+        parts.append(f'<link name="payload">{inertial(payload_kg, [0, 0, 0], np.eye(3) * 1e-6)}'
+                     f'</link><joint name="flange" type="fixed"><parent link="l{arm.n_joints}"/>'
+                     f'<child link="payload"/><origin xyz="{" ".join(map(str, arm.flange_xyz))}"'
+                     ' rpy="0 0 0"/></joint>')  # fmt: skip
+    return "".join(parts) + "</robot>"
+
+
+@pytest.mark.parametrize("name", ["fr3", "iiwa14"])
+def test_gravity_torques_agree_with_mujoco_reading_the_makers_urdf(name):
+    """Every seven-joint arm: the chain's holding torques at four poses within its limits, with
+    and without the rated payload, against MuJoCo's own URDF import (qfrc_bias at rest)."""
+    mujoco = pytest.importorskip("mujoco")
+    arm = load_arm(name)
+    low, high = arm.position_limit[:, 0], arm.position_limit[:, 1]
+    poses = [low + f * (high - low) for f in (0.5, 0.3, 0.7)] + [low + 0.9 * (high - low)]
+    for payload in (0.0, arm.payload_kg):
+        model = mujoco.MjModel.from_xml_string(_urdf(arm, payload))
+        data = mujoco.MjData(model)
+        for q in poses:
+            data.qpos[:] = q
+            mujoco.mj_forward(model, data)
+            ours, theirs = gravity_torques(arm, q, payload), data.qfrc_bias.copy()
+            assert np.max(np.abs(ours - theirs)) <= 0.005 * np.max(np.abs(theirs)), (q, payload)
+
+
+def test_the_iiwa14_carries_kukas_ratings_and_its_drivers_names():
+    iiwa = load_arm("iiwa14")
+    assert iiwa.n_joints == 7 and iiwa.maker == "KUKA" and iiwa.torque_sensors
+    np.testing.assert_array_equal(iiwa.rated_torque, [320, 320, 176, 176, 110, 40, 40])
+    assert iiwa.payload_kg == 14.0
+    assert iiwa.base_mass + sum(link.mass for link in iiwa.links) == pytest.approx(29.9, abs=0.01)
+    assert [tuple(link.axis) for link in iiwa.links][1] == (0.0, 1.0, 0.0)
