@@ -220,6 +220,11 @@ def test_a_research_script_imports_only_what_exists(script):
     needs a campaign's outputs)."""
     for module, names, line in _imports(script):
         where = f"{script.relative_to(REPO)}:{line}"
+        sibling = script.parent / f"{module}.py"
+        if sibling.is_file():  # a helper beside the script in its study's folder
+            defined = {n.name for n in ast.parse(sibling.read_text()).body if hasattr(n, "name")}
+            assert set(names) <= defined, f"{where}: {sibling.name} has no {set(names) - defined}"
+            continue
         if not module.startswith("robohealth_mj"):
             if module.split(".")[0] in ROS_VENV:  # a real ROS 2 node's side, run in its own venv
                 continue

@@ -192,8 +192,13 @@ def _load_chain(folder: Path, name: str) -> ArmDescription:
                               [i["xz"], i["yz"], i["zz"]]]),
             axis=_axis(item, path, *where),
         ))  # fmt: skip
-        limits.append([_number(item, path, *where, "limit", c)
-                       for c in ("lower", "upper", "velocity", "effort")])  # fmt: skip
+        limit = _field(item, path, *where, "limit")
+        bounds = [_number(item, path, *where, "limit", c) if c in limit else default
+                  for c, default in (("lower", -math.inf), ("upper", math.inf))]  # fmt: skip
+        if ("lower" in limit) != ("upper" in limit):
+            raise InputError(f"{path}: field joints.{k}.limit needs lower and upper, or neither")
+        limits.append([*bounds, *(_number(item, path, *where, "limit", c)
+                                  for c in ("velocity", "effort"))])  # fmt: skip
     lim = np.array(limits)
     names = tuple(str(n) for n in _field(data, path, "joint_names"))
     if len(names) != len(links):

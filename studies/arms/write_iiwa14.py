@@ -1,94 +1,52 @@
 """Write ``assets/iiwa14/arm.yaml`` from the community description of the KUKA LBR iiwa 14 R820
 (``lbr-stack/lbr_fri_ros2_stack``, ``lbr_description/urdf/iiwa14/``, Apache-2.0): its joint
-frames, axes and link inertials, read from the xacro's numbers; the rated torques from KUKA's
-datasheet (the description's efforts are a placeholder 200 N m on every joint).
+frames, axes and link inertials from the xacro, the position and speed limits from its
+``joint_limits.yaml`` (degrees), the rated torques from KUKA's datasheet (the description's
+efforts are a placeholder 200 N m on every joint).
 
-    bash studies/arms/fetch_iiwa14.sh   # the xacro and the joint limits at the cited commit
-    python studies/arms/write_iiwa14.py outputs/iiwa14/iiwa14_description.xacro \
-        outputs/iiwa14/joint_limits.yaml
+    bash studies/arms/fetch_iiwa14.sh   # the two files at the cited commit, into outputs/iiwa14/
+    python studies/arms/write_iiwa14.py outputs/iiwa14
 """
 
 from __future__ import annotations
 
 import math
-import re
 import sys
 from pathlib import Path
 
 import yaml
+from urdf_chain import description_yaml, read_chain
 
 from robohealth_mj.common.atomic import atomic_write_text
 
 COMMIT = "218d723f817c61314988833611effddc5333ca6c"
 # KUKA's LBR iiwa 14 R820 datasheet: maximum torque per axis (N m), rated payload, reach.
 RATED_TORQUE_NM = [320.0, 320.0, 176.0, 176.0, 110.0, 40.0, 40.0]
-PAYLOAD_KG, REACH_M = 14.0, 0.82
 OUT = Path(__file__).resolve().parents[2] / "assets" / "iiwa14" / "arm.yaml"
 
 
-def _numbers(text: str) -> list[float]:
-    return [float(v) for v in text.split()]
-
-
-def main(xacro: Path, limits_file: Path) -> None:
-    text = xacro.read_text()
-    limits = yaml.safe_load(limits_file.read_text())
-    links = {
-        m["name"]: m
-        for m in re.finditer(
-            r'<link name="\$\{robot_name\}_(?P<name>link_\d)">\s*<inertial>\s*'
-            r'<origin rpy="(?P<rpy>[^"]+)" xyz="(?P<xyz>[^"]+)" />\s*'
-            r'<mass value="(?P<mass>[^"]+)" />'
-            r"\s*<inertia (?P<inertia>[^/]+)/>",
-            text,
-        )
-    }
-    joints = list(re.finditer(
-        r'<joint name="\$\{robot_name\}_(?P<name>A\d)" type="revolute">\s*'
-        r'<origin rpy="(?P<rpy>[^"]+)" xyz="(?P<xyz>[^"]+)" />.*?<axis xyz="(?P<axis>[^"]+)" />',
-        text, re.S,
-    ))  # fmt: skip
-    flange = re.search(r'_joint_ee" type="fixed">.*?<origin xyz="([^"]+)"', text, re.S)
-    assert len(joints) == 7 and len(links) == 8 and flange, "the xacro's layout changed"
-    base = links["link_0"]
-    lines = [
-        "# KUKA LBR iiwa 14 R820 (`arm=iiwa14`): this project's own description, written by",
-        "# studies/arms/write_iiwa14.py from lbr-stack/lbr_fri_ros2_stack's lbr_description",
-        f"# (urdf/iiwa14/, Apache-2.0) at commit {COMMIT}; rated torques, payload and",
-        "# reach from KUKA's datasheet. Every number's origin: README.md.",
-        "name: iiwa14",
-        "maker: KUKA",
-        f"payload_kg: {PAYLOAD_KG}",
-        f"reach_m: {REACH_M}",
-        "# the LBR driver's joint names, under its robot name (lbr_A1 ...)",
-        "joint_names: [A1, A2, A3, A4, A5, A6, A7]",
-        "# a torque sensor in every joint; the FRI driver reports the measured torque",
-        "torque_sensors: true",
-        f"base: {{mass: {base['mass']}, com: [{', '.join(base['xyz'].split())}]}}   # link_0",
-        "joints:",
+def main(folder: Path) -> None:
+    chain, flange, base = read_chain(folder / "iiwa14_description.xacro", "link_0")
+    degrees = yaml.safe_load((folder / "joint_limits.yaml").read_text())
+    limits = [
+        {"lower": round(math.radians(d["lower"]), 6), "upper": round(math.radians(d["upper"]), 6),
+         "velocity": round(math.radians(d["velocity"]), 6), "effort": torque}
+        for d, torque in zip((degrees[j.name] for j in chain), RATED_TORQUE_NM, strict=True)
     ]  # fmt: skip
-    for k, joint in enumerate(joints):
-        link = links[f"link_{k + 1}"]
-        inertia = dict(re.findall(r'(i\w+)="([^"]+)"', link["inertia"]))
-        lim = limits[joint["name"]]
-        lines += [
-            f"  - origin_xyz: {_numbers(joint['xyz'])}",
-            f"    origin_rpy: {_numbers(joint['rpy'])}",
-            f"    axis: {_numbers(joint['axis'])}",
-            f"    limit: {{lower: {math.radians(lim['lower']):.6f}, upper: "
-            f"{math.radians(lim['upper']):.6f}, velocity: {math.radians(lim['velocity']):.6f}, "
-            f"effort: {RATED_TORQUE_NM[k]}}}",
-            f"    mass: {float(link['mass'])}",
-            f"    com: {_numbers(link['xyz'])}",
-            "    inertia: {" + ", ".join(
-                f"{c}: {float(inertia['i' + c])}" for c in ("xx", "yy", "zz", "xy", "xz", "yz")
-            ) + "}",
-        ]  # fmt: skip
-    lines += ["# The flange in link 7 (the description's link_ee): where a payload is carried.",
-              f"flange_xyz: {_numbers(flange[1])}"]  # fmt: skip
-    atomic_write_text(OUT, "\n".join(lines) + "\n")
+    header = [
+        "KUKA LBR iiwa 14 R820 (`arm=iiwa14`): this project's own description, written by",
+        "studies/arms/write_iiwa14.py from lbr-stack/lbr_fri_ros2_stack's lbr_description",
+        f"(urdf/iiwa14/, Apache-2.0) at commit {COMMIT};",
+        "rated torques, payload and reach from KUKA's datasheet. Every number's origin: README.md.",
+    ]
+    fields = {
+        "name": "iiwa14", "maker": "KUKA", "payload_kg": "14.0", "reach_m": "0.82",
+        "joint_names": f"[{', '.join(j.name for j in chain)}]   # the LBR driver's (lbr_A1 ...)",
+        "torque_sensors": "true   # one per joint; the FRI driver reports the measured torque",
+    }  # fmt: skip
+    atomic_write_text(OUT, description_yaml(header, fields, chain, limits, flange, base))
     print(f"-> {OUT}")
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]), Path(sys.argv[2]))
+    main(Path(sys.argv[1]))

@@ -123,13 +123,14 @@ def _urdf(arm, payload_kg: float) -> str:
     return "".join(parts) + "</robot>"
 
 
-@pytest.mark.parametrize("name", ["fr3", "iiwa14"])
+@pytest.mark.parametrize("name", ["fr3", "iiwa14", "gen3"])
 def test_gravity_torques_agree_with_mujoco_reading_the_makers_urdf(name):
     """Every seven-joint arm: the chain's holding torques at four poses within its limits, with
     and without the rated payload, against MuJoCo's own URDF import (qfrc_bias at rest)."""
     mujoco = pytest.importorskip("mujoco")
     arm = load_arm(name)
-    low, high = arm.position_limit[:, 0], arm.position_limit[:, 1]
+    limits = np.where(np.isfinite(arm.position_limit), arm.position_limit, [-np.pi, np.pi])
+    low, high = limits[:, 0], limits[:, 1]  # a joint without limits: one turn
     poses = [low + f * (high - low) for f in (0.5, 0.3, 0.7)] + [low + 0.9 * (high - low)]
     for payload in (0.0, arm.payload_kg):
         model = mujoco.MjModel.from_xml_string(_urdf(arm, payload))
@@ -148,3 +149,25 @@ def test_the_iiwa14_carries_kukas_ratings_and_its_drivers_names():
     assert iiwa.payload_kg == 14.0
     assert iiwa.base_mass + sum(link.mass for link in iiwa.links) == pytest.approx(29.9, abs=0.01)
     assert [tuple(link.axis) for link in iiwa.links][1] == (0.0, 1.0, 0.0)
+
+
+def test_the_gen3_is_kinovas_with_the_vision_module_and_four_endless_joints():
+    gen3 = load_arm("gen3")
+    assert gen3.n_joints == 7 and gen3.maker == "Kinova" and gen3.payload_kg == 4.0
+    np.testing.assert_array_equal(gen3.rated_torque, [39, 39, 39, 39, 9, 9, 9])
+    assert np.isinf(gen3.position_limit[[0, 2, 4, 6]]).all()
+    assert np.isfinite(gen3.position_limit[[1, 3, 5]]).all()
+    assert gen3.links[-1].mass == 0.5  # the bracelet with the vision module (0.364 kg without)
+    assert gen3.base_mass + sum(link.mass for link in gen3.links) == pytest.approx(8.19, abs=0.01)
+
+
+def test_a_limit_with_one_bound_is_refused(tmp_path, monkeypatch):
+    arm = tmp_path / "halfarm"
+    arm.mkdir()
+    text = (load_arm("gen3").source / "arm.yaml").read_text().replace("name: gen3", "name: halfarm")
+    (arm / "arm.yaml").write_text(
+        text.replace("limit: {velocity: 1.3963", "limit: {lower: -1, velocity: 1.3963", 1)
+    )
+    monkeypatch.setenv("ROBOHEALTH_ASSETS", str(tmp_path))
+    with pytest.raises(InputError, match=r"joints.0.limit needs lower and upper, or neither"):
+        load_arm("halfarm")
