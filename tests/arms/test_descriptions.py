@@ -123,7 +123,7 @@ def _urdf(arm, payload_kg: float) -> str:
     return "".join(parts) + "</robot>"
 
 
-@pytest.mark.parametrize("name", ["fr3", "iiwa14", "gen3"])
+@pytest.mark.parametrize("name", ["fr3", "iiwa14", "gen3", "xarm7"])
 def test_gravity_torques_agree_with_mujoco_reading_the_makers_urdf(name):
     """Every seven-joint arm: the chain's holding torques at four poses within its limits, with
     and without the rated payload, against MuJoCo's own URDF import (qfrc_bias at rest)."""
@@ -171,3 +171,10 @@ def test_a_limit_with_one_bound_is_refused(tmp_path, monkeypatch):
     monkeypatch.setenv("ROBOHEALTH_ASSETS", str(tmp_path))
     with pytest.raises(InputError, match=r"joints.0.limit needs lower and upper, or neither"):
         load_arm("halfarm")
+
+
+def test_the_xarm7_is_ufactorys_with_no_torque_sensors():
+    xarm = load_arm("xarm7")
+    assert xarm.n_joints == 7 and xarm.maker == "UFACTORY" and not xarm.torque_sensors
+    np.testing.assert_array_equal(xarm.rated_torque, [50, 50, 30, 30, 30, 20, 20])
+    assert xarm.joint_names == tuple(f"joint{k}" for k in range(1, 8)) and xarm.payload_kg == 3.5
