@@ -76,6 +76,26 @@ class ArmDescription:
     def n_joints(self) -> int:
         return len(self.links)
 
+    @property
+    def joint_keys(self) -> tuple[str, ...]:
+        """The joints' names in the model and the graph: the schema's on a UR arm, the driver's
+        on any other."""
+        return JOINT_NAMES if self.maker == "Universal Robots" else self.joint_names
+
+    @property
+    def link_bodies(self) -> tuple[str, ...]:
+        """The model's body of each link: UR's link names, ``link<k>`` on any other arm."""
+        if self.maker == "Universal Robots":
+            return LINK_BODIES
+        return tuple(f"link{k}" for k in range(1, self.n_joints + 1))
+
+    def home_pose(self) -> np.ndarray:
+        """``[J]`` the pose the model starts in: UR's home on a UR arm, else every joint at zero
+        or, where zero is outside its limits, at the nearer limit."""
+        if self.maker == "Universal Robots":
+            return np.array([-np.pi / 2, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
+        return np.clip(0.0, self.position_limit[:, 0], self.position_limit[:, 1])
+
     def ratings(self) -> dict[str, Any]:
         """The arm's identity and ratings, as manifests and checkpoints carry them."""
         return {

@@ -1,11 +1,12 @@
 """Building an arm's MuJoCo scene from its description, through dm-control's ``mjcf``.
 
-The body tree follows UR's URDF frames (each link's frame on its joint's axis, ``z`` along it),
-so joint zero and direction are the controller's. Every UR joint is two hinges on one axis in one
-body: ``<joint>_joint``, the motor side (rotor inertia, friction, the position servo), and
-``<joint>_deflection``, the drive's output twisting against it; a fixed tendon on the deflection
-hinge is the drive's compliance with a dead band of free play (backlash). The link angle a UR
-reports is the sum of the two. Geometry is primitive (for rendering and the floor only: links do
+The body tree follows the maker's URDF frames (each link's frame on its joint, the joint's axis
+as the description gives it, ``z`` on a UR), so joint zero and direction are the controller's;
+an arm of any joint count. Every joint is two hinges on one axis in one body: ``<joint>_joint``,
+the motor side (rotor inertia, friction, the position servo), and ``<joint>_deflection``, the
+drive's output twisting against it; a fixed tendon on the deflection hinge is the drive's
+compliance with a dead band of free play (backlash). The link angle a controller reports is the
+sum of the two. Geometry is primitive (for rendering and the floor only: links do
 not collide with each other).
 """
 
@@ -24,7 +25,7 @@ with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     from dm_control import mjcf
 
-from robohealth_mj.arms.description import LINK_BODIES, ArmDescription
+from robohealth_mj.arms.description import ArmDescription
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
 
@@ -83,15 +84,29 @@ class DriveModel:
             raise InputError(f"sim.reference_torque_nm needs {len(JOINT_NAMES)} values")
 
     def for_arm(self, arm: ArmDescription) -> dict[str, dict[str, float]]:
-        """Each joint's drive parameters on ``arm``."""
+        """Each joint's drive parameters on ``arm``: on a UR arm each joint's own, on any other
+        the UR5e joint of its class (:func:`reference_joint`), scaled by rated torque."""
         out = {}
-        for j, joint in enumerate(JOINT_NAMES):
-            scale = float(arm.rated_torque[j]) / float(self.reference_torque_nm[j])
+        for j, joint in enumerate(arm.joint_keys):
+            ref = joint if arm.joint_keys == JOINT_NAMES else reference_joint(arm, j)
+            scale = float(arm.rated_torque[j]) / float(
+                self.reference_torque_nm[JOINT_NAMES.index(ref)]
+            )
             out[joint] = {
                 k: float(v) * (1.0 if k in ANGLES else scale)
-                for k, v in self.reference[joint].items()
+                for k, v in self.reference[ref].items()
             }
         return out
+
+
+def reference_joint(arm: ArmDescription, j: int) -> str:
+    """The UR5e joint whose drive joint ``j`` of another arm takes: the last joint the UR5e's
+    last (the tool joint's soft drive), a joint rated at half the arm's largest torque or more a
+    base joint's (shoulder lift), any other a wrist's (wrist 2)."""
+    if j == arm.n_joints - 1:
+        return "wrist_3"
+    big = arm.rated_torque[j] >= 0.5 * float(np.max(arm.rated_torque))
+    return "shoulder_lift" if big else "wrist_2"
 
 
 def build_arm_scene(
@@ -119,13 +134,15 @@ def build_arm_scene(
     )
     r, h, m = arm.base_radius, arm.base_length, arm.base_mass  # UR's cylinder inertial
     ixx = m * (3 * r * r + h * h) / 12.0
-    base.add("inertial", mass=m, pos=[0, 0, 0], diaginertia=[ixx, ixx, m * r * r / 2.0])
+    moments = [ixx, ixx, m * r * r / 2.0] if r > 0 else [1e-3] * 3  # the base does not move
+    base.add("inertial", mass=m, pos=[0, 0, 0], diaginertia=moments)
     base.add("geom", name="base_housing", type="cylinder", size=[0.075 * size, 0.045 * size],
              pos=[0, 0, 0.045 * size], material="linkgray", contype=0, conaffinity=1)  # fmt: skip
 
     parent = base
+    big = arm.rated_torque >= 0.5 * float(np.max(arm.rated_torque))  # drawn as base joints
     for j, (joint, body_name, link) in enumerate(
-        zip(JOINT_NAMES, LINK_BODIES, arm.links, strict=True)
+        zip(arm.joint_keys, arm.link_bodies, arm.links, strict=True)
     ):
         body = parent.add(
             "body", name=body_name, pos=link.origin_xyz, quat=quat_rpy(link.origin_rpy)
@@ -137,13 +154,13 @@ def build_arm_scene(
         d = drives[joint]
         limited = bool(np.all(np.isfinite(arm.position_limit[j])))
         body.add(
-            "joint", name=f"{joint}_joint", type="hinge", axis=[0, 0, 1],
+            "joint", name=f"{joint}_joint", type="hinge", axis=link.axis,
             range=arm.position_limit[j] if limited else None, limited=limited,
             armature=d["armature"], damping=d["damping"], frictionloss=d["frictionloss"],
         )  # fmt: skip
-        body.add("joint", name=f"{joint}_deflection", type="hinge", axis=[0, 0, 1],
+        body.add("joint", name=f"{joint}_deflection", type="hinge", axis=link.axis,
                  armature=0, damping=0, frictionloss=0)  # fmt: skip
-        radius = (0.06 if j < 3 else 0.045) * size
+        radius = (0.06 if big[j] else 0.045) * size
         body.add("geom", name=f"{joint}_housing", type="cylinder", size=[radius, 1.1 * radius],
                  material="urblue", contype=0, conaffinity=1)  # fmt: skip
         if j + 1 < len(arm.links):  # the link's tube to the next joint
@@ -168,14 +185,15 @@ def build_arm_scene(
         parent = body
     parent.add("geom", name="flange", type="cylinder", size=[0.038 * size, 0.006 * size],
                pos=[0, 0, -0.006 * size], material="black", contype=0, conaffinity=0)  # fmt: skip
-    parent.add("site", name="tool_flange", pos=[0, 0, 0], size=[0.008 * size], group=4)
-    payload = parent.add("body", name="payload", pos=[0, 0, 0])
+    parent.add("site", name="tool_flange", pos=arm.flange_xyz, size=[0.008 * size], group=4)
+    payload = parent.add("body", name="payload", pos=arm.flange_xyz)
     # a point mass at the flange; the recorder sets its mass per curriculum segment
     payload.add("inertial", mass=arm.payload_kg * 0.4, pos=[0, 0, 0], diaginertia=[1e-9] * 3)
-    for joint in JOINT_NAMES:
+    for joint in arm.joint_keys:
         root.sensor.add("actuatorfrc", name=f"{joint}_effort", actuator=joint)
-    qpos = np.stack([HOME_POSE, np.zeros(6)], axis=1).ravel()
-    root.keyframe.add("key", name="home", qpos=qpos, ctrl=HOME_POSE)
+    home = arm.home_pose()
+    qpos = np.stack([home, np.zeros(arm.n_joints)], axis=1).ravel()
+    root.keyframe.add("key", name="home", qpos=qpos, ctrl=home)
     return root
 
 
