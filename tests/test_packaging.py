@@ -139,17 +139,23 @@ def test_the_wheel_carries_the_licence_and_the_notice(wheel):
     )
 
 
-def test_the_installed_wheel_records_from_an_empty_directory(wheel, tmp_path):
-    """Installed (not editable, not the source tree), from a directory with nothing in it: the
-    configs come from the package, the recording lands under that directory's ``outputs/``, and
-    a user's own config directory adds a group option (``--config-dir``)."""
-    site = tmp_path / "site"
+@pytest.fixture(scope="module")
+def site(wheel, tmp_path_factory) -> Path:
+    """The wheel installed into a folder of its own (not editable, not the source tree)."""
+    target = tmp_path_factory.mktemp("site")
     done = subprocess.run(
         [sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-compile",
-         "--target", str(site), str(wheel)],
+         "--target", str(target), str(wheel)],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     assert done.returncode == 0, done.stderr[-2000:]
+    return target
+
+
+def test_the_installed_wheel_records_from_an_empty_directory(site, tmp_path):
+    """Installed (not editable, not the source tree), from a directory with nothing in it: the
+    configs come from the package, the recording lands under that directory's ``outputs/``, and
+    a user's own config directory adds a group option (``--config-dir``)."""
     empty = tmp_path / "work"
     mine = empty / "my_conf" / "curriculum"
     mine.mkdir(parents=True)
@@ -170,20 +176,13 @@ def test_the_installed_wheel_records_from_an_empty_directory(wheel, tmp_path):
     assert json.loads(manifest.read_text())["sample_count"] == 20
 
 
-def test_the_installed_monitor_diagnoses_the_sample_with_a_ready_model(wheel, tmp_path):
+def test_the_installed_monitor_diagnoses_the_sample_with_a_ready_model(wheel, site, tmp_path):
     """``pip install 'robohealth_mj[monitor]'`` then one command, in an empty directory, with
     the simulator and the training stack out of reach: the stock model, by name, diagnoses the
     shipped sample log; the names are in the wheel with their cards."""
     names = set(zipfile.ZipFile(wheel).namelist())
     for name in ("full", "stock", "ur_driver"):
         assert {f"robohealth_mj/ready_models/{name}.{ext}" for ext in ("onnx", "md")} <= names
-    site = tmp_path / "site"
-    done = subprocess.run(
-        [sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-compile",
-         "--target", str(site), str(wheel)],
-        capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert done.returncode == 0, done.stderr[-2000:]
     empty = tmp_path / "work"
     empty.mkdir()
     env = {**os.environ, "PYTHONPATH": str(site), "PYTHONUNBUFFERED": "1"}
