@@ -52,7 +52,7 @@ class TrackingController:
     def inverse_dynamics(
         self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Motor torque and drive (spring) torque ``[n, 6]`` along a rigid reference motion."""
+        """Motor torque and drive (spring) torque ``[n, J]`` along a rigid reference motion."""
         idx, d = self.index, self.data
         motor = np.empty_like(q)
         spring = np.empty_like(q)
@@ -71,7 +71,7 @@ class TrackingController:
     def commands(
         self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Actuator commands and feed-forward torques for reference samples ``[n, 6]``."""
+        """Actuator commands and feed-forward torques for reference samples ``[n, J]``."""
         motor, spring = self.inverse_dynamics(q, qd, qdd)
         tau_ff = motor + self.coulomb * np.tanh(qd / self.coulomb_velocity_scale)
         ctrl = (q - self.twist(spring)) + (self.kv * qd + tau_ff) / self.kp
@@ -89,7 +89,7 @@ class TrackingController:
         )
 
     def static_twist(self, q: np.ndarray) -> np.ndarray:
-        """Drive deflection ``[6]`` that carries gravity at rest pose ``q`` (for a quiet start)."""
+        """Drive deflection ``[J]`` that carries gravity at rest pose ``q`` (for a quiet start)."""
         zeros = np.zeros((1, q.size))
         _, spring = self.inverse_dynamics(q[None], zeros, zeros)
         return self.twist(spring)[0]

@@ -25,11 +25,11 @@ def gravity_torques(q: np.ndarray, payload_kg: float = 0.0, arm: str = DEFAULT_A
     The payload is a point mass of ``payload_kg`` at the tool flange.
     """
     q = np.asarray(q, dtype=float)
-    if q.shape != (6,):
-        raise ValueError(f"q must have shape (6,), got {q.shape}")
+    model, index = nominal_model(arm)
+    if q.shape != index.actuator.shape:
+        raise ValueError(f"q must have shape {index.actuator.shape} on the {arm}, got {q.shape}")
     if payload_kg < 0:
         raise ValueError(f"payload_kg must be >= 0, got {payload_kg}")
-    model, index = nominal_model(arm)
     local = copy.copy(model)  # the cached nominal model is never edited
     local.body_mass[index.payload_body] = payload_kg
     data = mujoco.MjData(local)

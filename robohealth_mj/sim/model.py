@@ -19,7 +19,6 @@ from omegaconf import OmegaConf
 from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.resources import asset_dir, conf_dir
-from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.builder import DRIVE_KEYS, HOME_POSE, DriveModel, build_arm_scene
 
 ASSET_DIR = asset_dir()
@@ -85,9 +84,9 @@ def build_model(
         for joint, params in read_twin(twin, str(arm)).items():
             per_joint[joint].update(params)
     for joint, params in (drive_overrides or {}).items():
-        if joint not in JOINT_NAMES:
+        if joint not in description.joint_keys:
             raise KeyError(
-                f"drive override for unknown joint {joint!r}; known: {list(JOINT_NAMES)}"
+                f"drive override for unknown joint {joint!r}; known: {list(description.joint_keys)}"
             )
         unknown = sorted(set(params) - set(DRIVE_KEYS))
         if unknown:
@@ -124,8 +123,8 @@ class ArmIndex:
     deflection_dof: np.ndarray
     actuator: np.ndarray
     tendon: np.ndarray
-    acc_sensor: np.ndarray  # [6, 3] sensordata addresses
-    effort_sensor: np.ndarray  # [6]
+    acc_sensor: np.ndarray  # [J, 3] sensordata addresses
+    effort_sensor: np.ndarray  # [J]
     payload_body: int
     torque_limit: np.ndarray
 
@@ -134,18 +133,19 @@ class ArmIndex:
         def joint(name: str) -> mujoco._structs._MjModelJointViews:
             return model.joint(name)
 
-        motor = [joint(f"{j}_joint") for j in JOINT_NAMES]
-        defl = [joint(f"{j}_deflection") for j in JOINT_NAMES]
-        acc = [model.sensor(f"{j}_acc") for j in JOINT_NAMES]
-        eff = [model.sensor(f"{j}_effort") for j in JOINT_NAMES]
-        actuators = np.array([model.actuator(j).id for j in JOINT_NAMES])
+        keys = [model.actuator(k).name for k in range(model.nu)]  # one servo per joint, in order
+        motor = [joint(f"{j}_joint") for j in keys]
+        defl = [joint(f"{j}_deflection") for j in keys]
+        acc = [model.sensor(f"{j}_acc") for j in keys]
+        eff = [model.sensor(f"{j}_effort") for j in keys]
+        actuators = np.arange(model.nu)
         return cls(
             motor_qpos=np.array([int(m.qposadr[0]) for m in motor]),
             deflection_qpos=np.array([int(d.qposadr[0]) for d in defl]),
             motor_dof=np.array([int(m.dofadr[0]) for m in motor]),
             deflection_dof=np.array([int(d.dofadr[0]) for d in defl]),
             actuator=actuators,
-            tendon=np.array([model.tendon(f"{j}_drive").id for j in JOINT_NAMES]),
+            tendon=np.array([model.tendon(f"{j}_drive").id for j in keys]),
             acc_sensor=np.array([[int(s.adr[0]) + k for k in range(3)] for s in acc]),
             effort_sensor=np.array([int(s.adr[0]) for s in eff]),
             payload_body=model.body("payload").id,

@@ -74,3 +74,22 @@ def test_another_arms_joints_take_the_ur5e_drive_of_their_class():
         "shoulder_lift", "shoulder_lift", "shoulder_lift", "shoulder_lift", "wrist_2", "wrist_2",
         "wrist_3",
     ]  # fmt: skip
+
+
+@pytest.mark.parametrize("name", SEVEN)
+def test_the_index_and_the_nominal_model_serve_any_joint_count(name):
+    """ArmIndex reads the joints from the model's servos; the controller's nominal model gives
+    the holding torques of the chain (sim/dynamics.gravity_torques on a seven-joint arm)."""
+    from robohealth_mj.sim.dynamics import gravity_torques as model_gravity
+    from robohealth_mj.sim.model import ArmIndex
+
+    arm = load_arm(name)
+    index = ArmIndex.of(build_model(name))
+    assert index.motor_dof.shape == (7,) and index.acc_sensor.shape == (7, 3)
+    q = arm.home_pose() + 0.3
+    np.testing.assert_allclose(
+        model_gravity(q, arm.payload_kg, arm=name), gravity_torques(arm, q, arm.payload_kg),
+        rtol=1e-9, atol=1e-9,
+    )  # fmt: skip
+    with pytest.raises(ValueError, match=r"shape \(7,\)"):
+        model_gravity(np.zeros(6), arm=name)
