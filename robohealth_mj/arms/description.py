@@ -164,7 +164,14 @@ def _position_limit(lim: dict, path: Path, joint: tuple[str, str]) -> list[float
 
 
 def load_arm(name: str = DEFAULT_ARM) -> ArmDescription:
-    """The description of arm ``name`` (a folder of ``assets/``), validated field by field."""
+    """The description of arm ``name`` (a folder of ``assets/``, or a user's ``.urdf`` file),
+    validated field by field."""
+    if str(name).endswith(".urdf"):
+        from robohealth_mj.arms.urdf import arm_from_urdf  # it builds on this module
+
+        if not Path(name).is_file():
+            raise InputError(f"arm={name}: no such URDF file")
+        return arm_from_urdf(name)
     folder = asset_dir() / str(name)
     if not (folder / "arm.yaml").is_file():
         raise InputError(f"unknown arm {name!r}; known: {', '.join(known_arms())}")

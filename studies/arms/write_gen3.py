@@ -23,7 +23,8 @@ OUT = Path(__file__).resolve().parents[2] / "assets" / "gen3" / "arm.yaml"
 
 
 def main(folder: Path) -> None:
-    chain, flange, base = read_chain(folder / "gen3_macro.xacro", "base_link", CHOICES)
+    found = read_chain(folder / "gen3_macro.xacro", "base_link", CHOICES)
+    chain, flange, base = found.joints, found.flange, found.base
     limits = [
         {k: float(j.limit[k]) for k in ("lower", "upper", "velocity", "effort") if k in j.limit}
         for j in chain

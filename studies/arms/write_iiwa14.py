@@ -26,7 +26,8 @@ OUT = Path(__file__).resolve().parents[2] / "assets" / "iiwa14" / "arm.yaml"
 
 
 def main(folder: Path) -> None:
-    chain, flange, base = read_chain(folder / "iiwa14_description.xacro", "link_0")
+    found = read_chain(folder / "iiwa14_description.xacro", "link_0")
+    chain, flange, base = found.joints, found.flange, found.base
     degrees = yaml.safe_load((folder / "joint_limits.yaml").read_text())
     limits = [
         {"lower": round(math.radians(d["lower"]), 6), "upper": round(math.radians(d["upper"]), 6),
