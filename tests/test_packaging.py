@@ -221,7 +221,10 @@ def test_a_research_script_imports_only_what_exists(script):
         where = f"{script.relative_to(REPO)}:{line}"
         sibling = script.parent / f"{module}.py"
         if sibling.is_file():  # a helper beside the script in its study's folder
-            defined = {n.name for n in ast.parse(sibling.read_text()).body if hasattr(n, "name")}
+            body = ast.parse(sibling.read_text()).body
+            defined = {n.name for n in body if hasattr(n, "name")} | {
+                a.asname or a.name for n in body if isinstance(n, ast.ImportFrom) for a in n.names
+            }  # what it defines or imports for its scripts
             assert set(names) <= defined, f"{where}: {sibling.name} has no {set(names) - defined}"
             continue
         if not module.startswith("robohealth_mj"):
