@@ -1,14 +1,7 @@
 """``python -m robohealth_mj.tune_alarms --model M --data SESSION``: choose alarm settings on a
-selection recording (record one with a seed of its own; never tune on the held-out session).
 
-The model's decisions are computed once (``--healthy``: also on a healthy-only session, so that
-false alarms per hour rest on hours, not minutes), then every policy of the grid replays over
-them; the
-table (markdown) lists each policy's detection rate, false alarms and latency, and the last line
-names the chosen policy (see :func:`~robohealth_mj.deploy.alarm_sweep.choose`). Put it in
-``conf/monitor.yaml``'s ``evidence`` and ``alarm`` blocks. The grid covers memory (``evidence``:
-how window probabilities accumulate) and the alarm's debouncing together, since each changes
-what the other should be.
+The page (``--help`` prints it), the parser and what each subcommand prints live in
+:mod:`robohealth_mj.deploy.tune_cli`.
 """
 
 from __future__ import annotations

@@ -28,6 +28,8 @@ DEFAULT_ARM = "ur5e"
 # UR's link names in the description files, in the schema's joint order (joint i moves link i).
 LINK_KEYS = ("shoulder", "upper_arm", "forearm", "wrist_1", "wrist_2", "wrist_3")
 LINK_BODIES = tuple(f"{k}_link" for k in LINK_KEYS)
+# UR's home: the arm upright, the tool pointing down (the model's start pose on every UR arm).
+UR_HOME_POSE = np.array([-np.pi / 2, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
 
 
 class _Loader(yaml.SafeLoader):
@@ -71,6 +73,11 @@ class ArmDescription:
     maker: str = "Universal Robots"
     torque_sensors: bool = False  # a torque sensor in every joint, reported by the controller
     flange_xyz: np.ndarray = field(default_factory=lambda: np.zeros(3))  # in the last link
+    # The model's names and start pose where the loader fixes them (a UR arm: the schema's joint
+    # names, UR's link names, UR's home); otherwise the driver's names, link<k>, the zero pose.
+    model_keys: tuple[str, ...] = ()
+    model_bodies: tuple[str, ...] = ()
+    home: np.ndarray | None = None
 
     @property
     def n_joints(self) -> int:
@@ -80,20 +87,18 @@ class ArmDescription:
     def joint_keys(self) -> tuple[str, ...]:
         """The joints' names in the model and the graph: the schema's on a UR arm, the driver's
         on any other."""
-        return JOINT_NAMES if self.maker == "Universal Robots" else self.joint_names
+        return self.model_keys or self.joint_names
 
     @property
     def link_bodies(self) -> tuple[str, ...]:
         """The model's body of each link: UR's link names, ``link<k>`` on any other arm."""
-        if self.maker == "Universal Robots":
-            return LINK_BODIES
-        return tuple(f"link{k}" for k in range(1, self.n_joints + 1))
+        return self.model_bodies or tuple(f"link{k}" for k in range(1, self.n_joints + 1))
 
     def home_pose(self) -> np.ndarray:
         """``[J]`` the pose the model starts in: UR's home on a UR arm, else every joint at zero
         or, where zero is outside its limits, at the nearer limit."""
-        if self.maker == "Universal Robots":
-            return np.array([-np.pi / 2, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
+        if self.home is not None:
+            return self.home.copy()
         return np.clip(0.0, self.position_limit[:, 0], self.position_limit[:, 1])
 
     def ratings(self) -> dict[str, Any]:
@@ -311,6 +316,9 @@ def _load(folder: Path, name: str) -> ArmDescription:
         },
         source=folder,
         joint_names=tuple(f"{j}_joint" for j in JOINT_NAMES),  # the UR driver's
+        model_keys=JOINT_NAMES,
+        model_bodies=LINK_BODIES,
+        home=UR_HOME_POSE,
     )
     if desc.dh is not None and desc.dh["com"].shape != (6, 3):
         raise InputError(f"{dh_path}: field dh.com needs 6 rows of 3 values")

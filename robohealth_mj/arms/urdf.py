@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from robohealth_mj.arms.chain import link_frames
 from robohealth_mj.arms.description import ArmDescription, Link
 from robohealth_mj.common.errors import InputError
 
@@ -110,10 +111,10 @@ def read_chain(
     chain, flange, current = [], [0.0, 0.0, 0.0], base
     while children.get(current):
         moving = [j for j in children[current] if j.get("type") != "fixed"]
-        if len(moving) > 1 or (not moving and len(children[current]) > 1 and chain):
-            names = ", ".join(_name(j.get("name", "")) for j in children[current])
-            raise InputError(f"{path}: link '{current}' has {len(children[current])} child "
-                             f"joints ({names}): a serial arm has one")  # fmt: skip
+        if len(moving) > 1:  # fixed frames beside the next joint (a camera, a tool) are fine
+            names = ", ".join(_name(j.get("name", "")) for j in moving)
+            raise InputError(f"{path}: link '{current}' has {len(moving)} moving child joints "
+                             f"({names}): a serial arm has one")  # fmt: skip
         joint = (moving or children[current])[0]
         name, kind = _name(joint.get("name", "")), joint.get("type")
         child = _name(joint.find("child").get("link", ""))
@@ -195,8 +196,6 @@ def arm_from_urdf(path: Path | str) -> ArmDescription:
         raise InputError(f"{path}: no rated payload: write payload_kg (and reach_m) in "
                          f"{ratings_path.name} beside it")  # fmt: skip
     lim = np.array(limits)
-    from robohealth_mj.arms.chain import link_frames  # the reach: the flange at home, stretched
-
     desc = ArmDescription(
         name=path.stem, links=tuple(links), base_mass=chain.base["mass"], base_radius=0.0,
         base_length=0.0, rated_torque=lim[:, 3], speed_limit=lim[:, 2],

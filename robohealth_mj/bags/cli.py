@@ -1,5 +1,14 @@
-"""The command line of ``python -m robohealth_mj.bag`` (its page: the entry point's
-docstring): the parser and what each subcommand prints."""
+"""``python -m robohealth_mj.bag``: recordings as ROS 2 bags (rosbag2, MCAP storage).
+
+    python -m robohealth_mj.bag write SESSION [--out DIR]     # graphs.jsonl or a session dir
+    python -m robohealth_mj.bag info BAG
+    python -m robohealth_mj.bag plot BAG --out timeline.png   # truth and diagnosis, one timeline
+
+``write`` converts a recording to a bag directory that ``ros2 bag info`` and Foxglove open
+without plugins (standard messages only; topics in ``conf/bag.yaml``; the session manifest in the
+bag's metadata). Every command that reads recordings (``dataset``, ``train``, ``evaluate``,
+``monitor source=replay``) also takes such a bag directory.
+"""
 
 from __future__ import annotations
 

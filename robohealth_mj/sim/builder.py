@@ -25,7 +25,7 @@ with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     from dm_control import mjcf
 
-from robohealth_mj.arms.description import ArmDescription
+from robohealth_mj.arms.description import UR_HOME_POSE, ArmDescription
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.schema import JOINT_NAMES
 
@@ -33,7 +33,7 @@ REFERENCE_REACH_M = 0.85  # the UR5e, whose size the scene's cameras and housing
 DRIVE_KEYS = ("armature", "damping", "frictionloss", "stiffness", "tendon_damping", "backlash",
               "kp", "kv")  # fmt: skip
 ANGLES = ("backlash",)  # drive parameters that are angles: the same on every arm
-HOME_POSE = np.array([-np.pi / 2, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
+HOME_POSE = UR_HOME_POSE  # the schema's arms' start pose (the UR family)
 # The arm stands rotated about world z so that a UR5e's tool sits where the scene's cameras look.
 BASE_YAW = np.pi / 2
 

@@ -99,7 +99,7 @@ def test_the_built_model_holds_the_torques_mujoco_reads_from_the_users_file(tmp_
             ),
             2.0,
             "",
-            "link 'l3' has 2 child joints (j4, j4b): a serial arm has one",
+            "link 'l3' has 2 moving child joints (j4, j4b): a serial arm has one",
         ),
         (
             lambda t: t.replace(
