@@ -1,6 +1,7 @@
-"""``python -m robohealth_mj.bench``: throughput benchmarks (not tests); ``--help`` lists them.
+"""``python -m robohealth_mj.bench``: throughput benchmarks (not tests).
 
-The parser and each benchmark's printing live in :mod:`robohealth_mj.benchmarks.cli`.
+The page (``--help`` prints it), the parser and each benchmark's printing live in
+:mod:`robohealth_mj.benchmarks.cli`.
 """
 
 from __future__ import annotations

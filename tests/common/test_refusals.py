@@ -136,3 +136,17 @@ def test_the_monitor_at_its_default_source_names_the_simulators_extra(tmp_path):
     done = _on_the_deployment_install("robohealth_mj.monitor", ["monitor"], tmp_path)
     assert done.returncode == 2
     assert done.stderr.strip().endswith("pip install 'robohealth_mj[sim]'"), done.stderr[-1500:]
+
+
+@pytest.mark.parametrize("name", ["bag", "dataset", "report", "tune_alarms", "effects", "bench"])
+def test_a_file_centred_commands_help_prints_its_page(name, capsys):
+    """``--help`` on a flag-style command prints its usage page (examples included), the text
+    that lives beside its parser, not a note about where the code is."""
+    import importlib
+
+    entry = importlib.import_module(f"robohealth_mj.{name}")
+    with pytest.raises(SystemExit) as status:
+        entry.main(["--help"])
+    out = " ".join(capsys.readouterr().out.split())  # argparse may wrap the page
+    first = " ".join(entry.__doc__.strip().splitlines()[0].split())  # the page's first line
+    assert status.value.code == 0 and first in out and "live in" not in out
