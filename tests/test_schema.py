@@ -58,6 +58,43 @@ def test_a_formatted_line_validates_and_round_trips():
     assert sample.fault.fault_class == "none" and not sample.fault.active
 
 
+SEVEN = schema.ArmGraph(tuple(f"joint{k}" for k in range(1, 8)))
+
+
+def _seven_joint_obj() -> dict:
+    rng = np.random.default_rng(7)
+    x = node_features(
+        rng.normal(size=(7, len(schema.STATE_FEATURES))),
+        rng.normal(size=(7, len(schema.SENSOR_FEATURES))),
+    )
+    fault = FaultLabel("jam", "joint7", 0.6, True)
+    segment = {"index": 0, "family": "hold", "speed_scale": 1.0, "payload_scale": 1.0}
+    return json.loads(format_line("run-7", 0, 0.05, x, fault, segment, SEVEN))
+
+
+def test_the_graph_is_the_arms_any_joint_count_and_a_2_0_sample_is_the_ur_graph():
+    """Schema 3.0: a seven-joint arm's sample validates on its own graph (14 nodes, 26 edges,
+    its joints' names in the label); a 2.0 sample reads as the UR's six-joint graph and only
+    that; a sample of another arm than the one expected is refused naming the nodes."""
+    sample = validate_sample(_seven_joint_obj())
+    assert sample.graph == SEVEN and sample.x.shape == (14, schema.N_FEATURES)
+    assert len(SEVEN.edges) == 26 and sample.fault.joint == "joint7"
+    old = {**_sample_obj(), "schema_version": "2.0"}
+    assert validate_sample(old).graph == schema.UR_GRAPH
+    seven_as_old = {**_seven_joint_obj(), "schema_version": "2.0"}
+    with pytest.raises(SchemaError, match=r"field 'nodes': node order .* the 2.0 schema's"):
+        validate_sample(seven_as_old)
+    with pytest.raises(SchemaError, match=r"field 'nodes': node order .* differs from the arm's"):
+        validate_sample(_sample_obj(), graph=SEVEN)
+    wrong_joint = _seven_joint_obj()
+    wrong_joint["fault"]["joint"] = "elbow"
+    with pytest.raises(SchemaError, match=r"field 'fault.joint': unknown joint 'elbow'"):
+        validate_sample(wrong_joint)
+    not_an_arm = {**_seven_joint_obj(), "nodes": [f"n{k}" for k in range(14)]}
+    with pytest.raises(SchemaError, match=r"field 'nodes': node order .* is not J joints"):
+        validate_sample(not_an_arm)
+
+
 def _set(path: str, value):
     def edit(obj):
         target = obj

@@ -21,7 +21,7 @@ import numpy as np
 import yaml
 
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.common.resources import asset_dir
+from robohealth_mj.common.resources import asset_dir, is_arm_file
 from robohealth_mj.schema import JOINT_NAMES
 
 DEFAULT_ARM = "ur5e"
@@ -95,11 +95,27 @@ class ArmDescription:
         return self.model_bodies or tuple(f"link{k}" for k in range(1, self.n_joints + 1))
 
     def home_pose(self) -> np.ndarray:
-        """``[J]`` the pose the model starts in: UR's home on a UR arm, else every joint at zero
-        or, where zero is outside its limits, at the nearer limit."""
+        """``[J]`` the pose the model starts in and the curriculum moves about: UR's home on a UR
+        arm, else each joint in the middle of its range (zero where it turns without limit), so
+        every joint has room to sweep both ways."""
         if self.home is not None:
             return self.home.copy()
-        return np.clip(0.0, self.position_limit[:, 0], self.position_limit[:, 1])
+        low, high = self.position_limit[:, 0], self.position_limit[:, 1]
+        finite = np.isfinite(low) & np.isfinite(high)
+        return np.where(finite, 0.5 * (np.where(finite, low, 0) + np.where(finite, high, 0)), 0.0)
+
+    def ur_counterparts(self) -> tuple[str, ...]:
+        """For each joint, the UR5e joint whose drive and motion it takes (the drive model and
+        the curriculum are stated for the UR5e): on a UR arm its own; on another the last
+        joint the UR's last (the tool joint), a joint rated at half the arm's largest torque or
+        more a base joint's (shoulder lift), any other a wrist's (wrist 2)."""
+        if self.joint_keys == JOINT_NAMES:
+            return JOINT_NAMES
+        big = self.rated_torque >= 0.5 * float(np.max(self.rated_torque))
+        return tuple(
+            "wrist_3" if j == self.n_joints - 1 else ("shoulder_lift" if big[j] else "wrist_2")
+            for j in range(self.n_joints)
+        )
 
     def ratings(self) -> dict[str, Any]:
         """The arm's identity and ratings, as manifests and checkpoints carry them."""
@@ -110,6 +126,11 @@ class ArmDescription:
             "payload_kg": self.payload_kg,
             "reach_m": self.reach_m,
         }
+
+
+def short_name(name: str) -> str:
+    """The name to show and to put in run ids: a shipped arm's own, a file's stem."""
+    return Path(name).stem if is_arm_file(name) else str(name)
 
 
 def known_arms() -> tuple[str, ...]:
@@ -171,7 +192,7 @@ def _position_limit(lim: dict, path: Path, joint: tuple[str, str]) -> list[float
 def load_arm(name: str = DEFAULT_ARM) -> ArmDescription:
     """The description of arm ``name`` (a folder of ``assets/``, or a user's ``.urdf`` file),
     validated field by field."""
-    if str(name).endswith(".urdf"):
+    if is_arm_file(name):
         from robohealth_mj.arms.urdf import arm_from_urdf  # it builds on this module
 
         if not Path(name).is_file():

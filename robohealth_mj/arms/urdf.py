@@ -197,7 +197,7 @@ def arm_from_urdf(path: Path | str) -> ArmDescription:
                          f"{ratings_path.name} beside it")  # fmt: skip
     lim = np.array(limits)
     desc = ArmDescription(
-        name=path.stem, links=tuple(links), base_mass=chain.base["mass"], base_radius=0.0,
+        name=str(path.resolve()), links=tuple(links), base_mass=chain.base["mass"], base_radius=0.0,
         base_length=0.0, rated_torque=lim[:, 3], speed_limit=lim[:, 2],
         position_limit=lim[:, :2], payload_kg=float(ratings["payload_kg"]),
         reach_m=float(ratings.get("reach_m", 0.0)) or 1.0, dh=None, source=path.parent,

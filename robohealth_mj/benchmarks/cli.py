@@ -11,6 +11,7 @@
     python -m robohealth_mj.bench soak [--model M] [--streams 1000] [--seconds 60]
     python -m robohealth_mj.bench ros2 --model M [--arms 10 25 50] [--seconds 20] [--monitors 1 2]
     python -m robohealth_mj.bench contact [--streams 100 1000 4000]
+    python -m robohealth_mj.bench mixed --model A.onnx B.onnx --data A_DATA B_DATA [--streams 500]
 
 ``sim`` measures, in one run, the raw ``mj_step`` rate of the scene and the recorder's throughput
 (physics + control + sensor synthesis + JSONL writing), and reports their ratio. ``train
@@ -20,7 +21,8 @@ recordings on many interleaved 20 Hz streams through the fleet runtime: the larg
 whose per-tick p99 fits the 50 ms tick (search), then a paced run at ``--streams`` with its CPU
 share, and the windowed path beside the incremental one. ``soak`` runs a fleet under bad input
 (see ``robohealth_mj/benchmarks/soak.py``) and checks every flagged row and the memory. ``contact``
-times the contact watch's update over streams that all hold a pose (its worst case).
+times the contact watch's update over streams that all hold a pose (its worst case). ``mixed``
+runs two arms' models (a six- and a seven-joint arm) in one process against each alone.
 """
 
 from __future__ import annotations
@@ -70,6 +72,12 @@ def main(argv: list[str] | None = None) -> None:
     ros2 = sub.add_parser("ros2", help="arms per monitor over DDS on loopback, end-to-end latency")
     contact = sub.add_parser("contact", help="the contact watch's cost per fleet tick")
     contact.add_argument("--streams", type=int, nargs="+", default=[100, 1000, 4000])
+    mixed = sub.add_parser("mixed", help="a mixed fleet (two arm kinds) against each alone")
+    mixed.add_argument("--model", nargs=2, required=True, help="two exported models")
+    mixed.add_argument("--data", nargs=2, required=True, help="each model's arm's recordings")
+    mixed.add_argument("--streams", type=int, default=500, help="streams of each arm kind")
+    mixed.add_argument("--ticks", type=int, default=100, help="timed ticks per run")
+    mixed.add_argument("--rounds", type=int, default=3, help="alternated rounds")
     ros2.add_argument("--model", required=True, help="an exported model.onnx")
     ros2.add_argument("--data", default="outputs/corpus/quick/heldout_seed900")
     ros2.add_argument("--arms", type=int, nargs="+", default=[10, 25, 50])
@@ -124,7 +132,13 @@ def main(argv: list[str] | None = None) -> None:
         help="alternated rounds of the with/without-memory comparison (0: skip it)",
     )
     args = parser.parse_args(argv)
-    if args.what == "contact":
+    if args.what == "mixed":
+        from robohealth_mj.benchmarks.mixed import bench_mixed
+        from robohealth_mj.common.errors import one_line_errors
+
+        with one_line_errors("bench"):
+            bench_mixed(args.model, args.data, args.streams, args.ticks, args.rounds)
+    elif args.what == "contact":
         from robohealth_mj.benchmarks.contact import bench_contact
 
         bench_contact(args.streams)

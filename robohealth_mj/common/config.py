@@ -9,6 +9,7 @@ import os
 import re
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any, TypeVar
 
 import hydra
@@ -22,7 +23,7 @@ from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
 from robohealth_mj.common.errors import InputError, report
-from robohealth_mj.common.resources import HYDRA_CONF, conf_dir
+from robohealth_mj.common.resources import HYDRA_CONF, conf_dir, is_arm_file
 
 T = TypeVar("T")
 
@@ -98,7 +99,7 @@ def run_tool(
         returned.append(task(cfg))
 
     app = hydra.main(config_path=HYDRA_CONF, config_name=name, version_base="1.3")(job)
-    args = sys.argv[1:] if argv is None else list(argv)
+    args = [_arm_file(a) for a in (sys.argv[1:] if argv is None else list(argv))]
     checked = _check_before_hydra(name, args)
     before = os.environ.get("HYDRA_FULL_ERROR")
     os.environ["HYDRA_FULL_ERROR"] = "1"
@@ -126,6 +127,15 @@ def run_tool(
         else:
             os.environ["HYDRA_FULL_ERROR"] = before
     return returned[-1] if returned else None
+
+
+def _arm_file(arg: str) -> str:
+    """``arm=<your.urdf>`` is the arm group's ``name`` set to the file (absolute, so it reads
+    back from any directory): a file is not one of the group's options."""
+    key, _, value = arg.partition("=")
+    if key in ("arm", "+arm") and is_arm_file(value):
+        return f"arm.name={Path(value).resolve()}"
+    return arg
 
 
 _FLAGS_WITH_VALUE = ("--config-dir", "-cd", "--config-path", "-cp", "--config-name", "-cn",

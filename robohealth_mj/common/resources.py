@@ -32,3 +32,10 @@ READY_PACKAGE = "robohealth_mj.ready_models"
 def ready_dir() -> Path:
     """The packaged ready models (``ready_models/``: exported models, their cards, a sample)."""
     return Path(str(files(READY_PACKAGE)))
+
+
+def is_arm_file(name: str) -> bool:
+    """Whether ``name`` names a user's arm file (a URDF) rather than an arm of ``assets/``; such
+    an arm's name is the file's absolute path, so it reads back the same from every file and
+    directory it is named in."""
+    return str(name).endswith(".urdf")

@@ -19,7 +19,7 @@ from robohealth_mj.common.atomic import atomic_write_bytes
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.read import is_bag, read_samples, recording_arm
 from robohealth_mj.data.relative import REFERENCE_ARM, to_relative
-from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, SCHEMA_VERSION
+from robohealth_mj.schema import FAULT_CLASSES, SCHEMA_VERSION, UR_GRAPH, ArmGraph
 
 CACHE_SUFFIX = ".cache.npz"
 
@@ -35,12 +35,13 @@ class Recording:
     run_ids: list[str]
     sample_index: np.ndarray  # [T] int64
     fault_class: np.ndarray  # [T] int64, index into FAULT_CLASSES
-    fault_joint: np.ndarray  # [T] int64, index into JOINT_NAMES, -1 when healthy
+    fault_joint: np.ndarray  # [T] int64, index into graph.joints, -1 when healthy
     severity: np.ndarray  # [T] float32
     active: np.ndarray  # [T] bool
     payload_scale: np.ndarray  # [T] float32
     sources: list[str]
     arms: list[str] = field(default_factory=list)  # [len(run_ids)] the arm of each run
+    graph: ArmGraph = UR_GRAPH  # the arm graph of every sample (N = 2 J nodes)
 
     def __len__(self) -> int:
         return len(self.x)
@@ -69,18 +70,24 @@ def _key(path: Path) -> str:
 def _parse(path: Path) -> dict[str, np.ndarray]:
     xs, runs, idx, cls, joint, sev, act, payload = [], [], [], [], [], [], [], []
     run_ids: dict[str, int] = {}
+    graph: ArmGraph | None = None
     for s in read_samples(path):
+        if graph is not None and s.graph != graph:
+            raise InputError(f"{path}: samples of two arm graphs ({graph.n_joints} and "
+                             f"{s.graph.n_joints} joints) in one file")  # fmt: skip
+        graph = s.graph
         xs.append(s.x)
         runs.append(run_ids.setdefault(s.recording_run_id, len(run_ids)))
         idx.append(s.sample_index)
         cls.append(FAULT_CLASSES.index(s.fault.fault_class))
-        joint.append(JOINT_NAMES.index(s.fault.joint) if s.fault.active else -1)
+        joint.append(graph.joints.index(s.fault.joint) if s.fault.active else -1)
         sev.append(s.fault.severity if s.fault.active else 0.0)
         act.append(s.fault.active)
         payload.append(float(s.segment["payload_scale"]))
-    if not xs:
+    if not xs or graph is None:
         raise InputError(f"{path}: no samples (an empty recording)")
     return {
+        "joints": np.array(graph.joints),
         "x": np.stack(xs).astype(np.float32),
         "run": np.array(runs, np.int32),
         "run_ids": np.array(list(run_ids)),
@@ -139,6 +146,10 @@ def load_recordings(paths: list[Path | str], arm: str | None = None) -> Recordin
             part = {**part, "x": to_relative(part["x"], name)}
         parts.append(part)
         arms += [name] * len(part["run_ids"])
+    graphs = {tuple(str(j) for j in p.get("joints", UR_GRAPH.joints)) for p in parts}
+    if len(graphs) > 1:
+        shown = "; ".join(", ".join(g) for g in sorted(graphs))
+        raise InputError(f"recordings of one arm graph expected (one model reads one); got {shown}")
     run_ids: list[str] = []
     runs = []
     for part in parts:
@@ -165,6 +176,7 @@ def load_recordings(paths: list[Path | str], arm: str | None = None) -> Recordin
         run_ids=run_ids,
         sources=[str(p) for p in paths],
         arms=arms,
+        graph=ArmGraph(graphs.pop()) if graphs else UR_GRAPH,
         **cat,
     )
 

@@ -25,13 +25,15 @@ COULOMB_SCALE = 0.05  # rad/s: the controller's own smoothing of the friction si
 N_BASIS = 11
 
 
-def basis(x: Any) -> Any:
-    """Schema snapshots ``[..., 12, F]`` -> per-joint regressors ``[..., 6, N_BASIS]``: a
-    constant, the smoothed direction of motion, the speed, and the gravity terms of the arm's
-    pitch chain (cos and sin of the summed shoulder-lift, elbow, wrist-1 angles; wrist 2)."""
+def basis(x: Any, joints: int = schema.N_JOINTS) -> Any:
+    """Snapshots ``[..., 2J (or J), F]`` of an arm of ``joints`` joints -> per-joint regressors
+    ``[..., J, N_BASIS]``: a constant, the smoothed direction of motion, the speed, and the
+    gravity terms of a UR's pitch chain (cos and sin of the summed shoulder-lift, elbow, wrist-1
+    angles; wrist 2); on another arm (five joints or more) the same terms of its joints 2-5, a
+    rougher basis that the fit weighs per joint."""
     xp = _xp(x)
-    q = x[..., : schema.N_JOINTS, schema.feature_index("pos")]
-    qd = x[..., : schema.N_JOINTS, schema.feature_index("vel")]
+    q = x[..., :joints, schema.feature_index("pos")]
+    qd = x[..., :joints, schema.feature_index("vel")]
     a1, a2, a3 = q[..., 1], q[..., 1] + q[..., 2], q[..., 1] + q[..., 2] + q[..., 3]
     shared = [xp.cos(a1), xp.sin(a1), xp.cos(a2), xp.sin(a2), xp.cos(a3), xp.sin(a3),
               xp.cos(q[..., 4]), xp.sin(q[..., 4])]  # fmt: skip
@@ -41,12 +43,13 @@ def basis(x: Any) -> Any:
 
 
 def fit(x: np.ndarray) -> np.ndarray:
-    """Least-squares baseline ``W [6, 2, N_BASIS]`` of the residual channels on healthy
-    snapshots ``x [T, 12, F]`` (a small ridge keeps a joint that never moved well posed)."""
-    b = basis(x.astype(np.float64))  # [T, 6, B]
-    out = np.zeros((schema.N_JOINTS, len(RESIDUALS), N_BASIS))
+    """Least-squares baseline ``W [J, 2, N_BASIS]`` of the residual channels on healthy
+    snapshots ``x [T, 2J, F]`` (a small ridge keeps a joint that never moved well posed)."""
+    joints = x.shape[-2] // 2
+    b = basis(x.astype(np.float64), joints)  # [T, J, B]
+    out = np.zeros((joints, len(RESIDUALS), N_BASIS))
     ridge = 1e-6 * len(x) * np.eye(N_BASIS)
-    for j in range(schema.N_JOINTS):
+    for j in range(joints):
         gram = b[:, j].T @ b[:, j] + ridge
         for c, name in enumerate(RESIDUALS):
             target = x[:, j, schema.feature_index(name)].astype(np.float64)
@@ -55,14 +58,14 @@ def fit(x: np.ndarray) -> np.ndarray:
 
 
 def shift(x: Any, delta: Any) -> Any:
-    """``x [..., 12, F]`` with each joint's residual channels moved by ``-basis @ delta``
-    (``delta [6, 2, N_BASIS]`` = the arm's baseline minus the reference's), on the joint nodes and
+    """``x [..., 2J (or J), F]`` with each joint's residual channels moved by ``-basis @ delta``
+    (``delta [J, 2, N_BASIS]`` = the arm's baseline minus the reference's), on the joint nodes and
     on the copies the schema puts on the sensor nodes."""
     xp = _xp(x)
-    moved = (basis(x)[..., None, :] * delta).sum(-1)  # [..., 6, 2]
+    j = delta.shape[0]
+    moved = (basis(x, j)[..., None, :] * delta).sum(-1)  # [..., J, 2]
     cols = [schema.feature_index(n) for n in RESIDUALS]
     out = x.copy() if xp is np else x.clone()
-    j = schema.N_JOINTS
     for c, col in enumerate(cols):
         out[..., :j, col] = x[..., :j, col] - moved[..., c]
         if x.shape[-2] > j:

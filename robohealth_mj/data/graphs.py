@@ -1,6 +1,6 @@
 """The graphs a model can be trained on: the structural schema graph, or the unknown-placement
 harness (thesis §2.6.4) where four off-joint sensors mix the six per-joint sensor packages through
-a ground-truth coupling ``C0 [6, 4]`` that no model is shown.
+a ground-truth coupling ``C0 [6, 4]`` that no model is shown (on an arm of J joints, ``[J, M]``).
 """
 
 from __future__ import annotations
@@ -39,16 +39,46 @@ class GraphSpec:
     num_joints: int
     coupling: np.ndarray | None = None  # C0 [J, M] for the harness
     sensing: str = "full"  # the sensing profile (data/sensing.py) whose channels the graph keeps
-    channel_mask: np.ndarray | None = None  # [12, F] 1 kept / 0 zeroed, on the schema's nodes
-    schema_nodes: int = schema.N_NODES  # the leading schema nodes read (6: the joints only)
+    channel_mask: np.ndarray | None = None  # [2J, F] 1 kept / 0 zeroed, on the arm's nodes
+    schema_nodes: int = schema.N_NODES  # the leading arm nodes read (J: the joints only)
     classes: tuple[str, ...] = schema.FAULT_CLASSES  # the label set (the profile's)
-    baseline_shift: np.ndarray | None = None  # [6, 2, B] commissioning (data/baseline.py)
+    baseline_shift: np.ndarray | None = None  # [J, 2, B] commissioning (data/baseline.py)
+    arm: schema.ArmGraph = schema.UR_GRAPH  # the arm graph the recordings carry
+    coupling_seed: int | None = None  # the harness's drawn placement: redrawn for another arm
+
+    def for_arm(self, arm: schema.ArmGraph) -> GraphSpec:
+        """This graph on ``arm``'s joints (the recordings' graph; before :meth:`with_sensing`):
+        the structural graph is the arm's own; the harness keeps its sensors, its placement
+        redrawn from its seed for the arm's joints, or refused where a given one does not fit."""
+        if arm == self.arm:
+            return self
+        if self.coupling is None:
+            return replace(
+                self, node_names=arm.nodes, adjacency=arm.adjacency(), num_joints=arm.n_joints,
+                schema_nodes=arm.n_nodes, arm=arm,
+            )  # fmt: skip
+        m = self.coupling.shape[1]
+        if self.coupling_seed is not None:
+            c = random_coupling(self.coupling_seed, m, arm.n_joints)
+        elif self.coupling.shape[0] == arm.n_joints:
+            c = self.coupling
+        else:
+            raise InputError(
+                f"graph=harness: the placement is [{self.coupling.shape[0]}, {m}], for "
+                f"{self.coupling.shape[0]} joints; the recordings' arm has {arm.n_joints}: set "
+                "graph.coupling_seed (a placement drawn for its joints) or graph.coupling_file"
+            )
+        spec = harness_graph(c, arm=arm)
+        return replace(spec, coupling_seed=self.coupling_seed)
 
     def with_sensing(self, profile) -> GraphSpec:
         """This graph reading only the channels ``profile`` (a SensingProfile) names; without
         sensor channels, without the sensor nodes."""
         spec = replace(
-            self, sensing=profile.name, channel_mask=profile.mask(), classes=profile.label_set
+            self,
+            sensing=profile.name,
+            channel_mask=profile.mask(self.arm.n_joints),
+            classes=profile.label_set,
         )
         if profile.sensor_nodes:
             return spec
@@ -79,7 +109,7 @@ class GraphSpec:
         )
 
     def transform(self, x: np.ndarray) -> np.ndarray:
-        """Schema snapshots ``[..., 12, F]`` -> this graph's node features ``[..., N, F]``."""
+        """Arm snapshots ``[..., 2J, F]`` -> this graph's node features ``[..., N, F]``."""
         if self.baseline_shift is not None:  # this arm's residuals onto the training arms'
             x = shift(x, self.baseline_shift).astype(np.float32)
         if self.channel_mask is not None:
@@ -88,7 +118,7 @@ class GraphSpec:
             x = np.ascontiguousarray(x[..., : self.schema_nodes, :])
         if self.coupling is None:
             return x
-        j = schema.N_JOINTS
+        j = self.num_joints
         mixed = np.einsum("jm,...jc->...mc", self.coupling, x[..., j:, schema.SENSOR_CHANNELS])
         sensors = np.zeros((*x.shape[:-2], self.coupling.shape[1], schema.N_FEATURES), np.float32)
         sensors[..., 1] = 1.0  # is_sensor; joint-state channels stay zero
@@ -107,15 +137,20 @@ class GraphSpec:
             "schema_nodes": self.schema_nodes,
             "classes": list(self.classes),
             "baseline_shift": None if self.baseline_shift is None else self.baseline_shift.tolist(),
+            "joints": list(self.arm.joints),
+            "coupling_seed": self.coupling_seed,
         }
 
 
-def structural_graph() -> GraphSpec:
-    return GraphSpec("structural", schema.NODE_NAMES, schema.adjacency(), schema.N_JOINTS)
+def structural_graph(arm: schema.ArmGraph = schema.UR_GRAPH) -> GraphSpec:
+    """The arm's own graph: its joints along the chain, a sensor package on each."""
+    return GraphSpec(
+        "structural", arm.nodes, arm.adjacency(), arm.n_joints, schema_nodes=arm.n_nodes, arm=arm
+    )
 
 
 def load_coupling(path: str | Path) -> np.ndarray:
-    """A ``[6, M]`` non-negative coupling from ``.npy``, ``.json`` or ``.csv``."""
+    """A ``[J, M]`` non-negative coupling from ``.npy``, ``.json`` or ``.csv``."""
     path = Path(path)
     if path.suffix == ".npy":
         c = np.load(path)
@@ -124,8 +159,8 @@ def load_coupling(path: str | Path) -> np.ndarray:
     else:
         c = np.loadtxt(path, delimiter=",", dtype=np.float32, ndmin=2)
     c = np.asarray(c, dtype=np.float32)
-    if c.ndim != 2 or c.shape[0] != schema.N_JOINTS or c.shape[1] < 1:
-        raise InputError(f"{path}: coupling must be [{schema.N_JOINTS}, M], got {c.shape}")
+    if c.ndim != 2 or c.shape[0] < 2 or c.shape[1] < 1:
+        raise InputError(f"{path}: coupling must be [J, M] (a row per joint), got {c.shape}")
     if not _reaches(c):
         raise InputError(f"{path}: {_UNREACHED}")
     return c
@@ -138,7 +173,9 @@ def _reaches(c: np.ndarray) -> bool:
     return bool(np.all(c >= 0) and np.all(c.sum(axis=1) > 0))
 
 
-def random_coupling(seed: int, sensors: int = 4, joints: int = schema.N_JOINTS) -> np.ndarray:
+def random_coupling(
+    seed: int, sensors: int = 4, joints: int = schema.UR_GRAPH.n_joints
+) -> np.ndarray:
     """A placement nobody measured, drawn from ``seed``: ``[joints, sensors]``, non-negative.
 
     Each joint reaches a primary sensor (weight in [0.6, 1]) and, with probability one half, a
@@ -183,10 +220,12 @@ def harness_graph(
     coupling_file: str | None = None,
     coupling_seed: int | None = None,
     coupling_sensors: int = 4,
+    arm: schema.ArmGraph = schema.UR_GRAPH,
 ) -> GraphSpec:
     """Joints keep their backbone; every joint links to every harness sensor (dense bipartite),
     so message passing is not told the coupling either. C0: the default, a matrix, a file, or
-    a random placement of ``coupling_sensors`` sensors drawn from ``coupling_seed``."""
+    a random placement of ``coupling_sensors`` sensors drawn from ``coupling_seed`` (for the
+    UR's six joints; :meth:`GraphSpec.for_arm` takes it to another arm's)."""
     given = [k for k, v in (("coupling", coupling), ("coupling_file", coupling_file),
                             ("coupling_seed", coupling_seed)) if v is not None]  # fmt: skip
     if len(given) > 1:
@@ -198,13 +237,20 @@ def harness_graph(
     else:
         c = DEFAULT_C0 if coupling is None else np.asarray(coupling, dtype=np.float32)
     j, m = c.shape
+    if j != arm.n_joints:
+        raise InputError(
+            f"graph: the coupling has {j} rows, one per joint; the arm has {arm.n_joints}"
+        )
     n = j + m
     adj = np.zeros((n, n), np.float32)
     for i in range(j - 1):
         adj[i, i + 1] = adj[i + 1, i] = 1.0
     adj[:j, j:] = adj[j:, :j] = 1.0
-    names = schema.JOINT_NAMES + tuple(f"harness_sensor_{k}" for k in range(m))
-    return GraphSpec("harness", names, adj, j, c)
+    names = arm.joints + tuple(f"harness_sensor_{k}" for k in range(m))
+    seed = None if coupling_seed is None else int(coupling_seed)
+    return GraphSpec(
+        "harness", names, adj, j, c, schema_nodes=arm.n_nodes, arm=arm, coupling_seed=seed
+    )
 
 
 def coupling_correlation(learned: np.ndarray, truth: np.ndarray) -> float:

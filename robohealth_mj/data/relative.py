@@ -30,10 +30,12 @@ SPEED_CHANNELS = ("vel",)
 @cache
 def _scale(arm: str) -> np.ndarray:
     own, ref = load_arm(arm), load_arm(REFERENCE_ARM)
-    scale = np.ones((schema.N_NODES, schema.N_FEATURES), np.float32)
-    torque = (ref.rated_torque / own.rated_torque).astype(np.float32)
-    speed = (ref.speed_limit / own.speed_limit).astype(np.float32)
-    j = schema.N_JOINTS
+    j = own.n_joints
+    scale = np.ones((2 * j, schema.N_FEATURES), np.float32)
+    # each joint against the reference arm's joint of its class (an arm of other joints)
+    k = [ref.joint_keys.index(c) for c in own.ur_counterparts()]
+    torque = (ref.rated_torque[k] / own.rated_torque).astype(np.float32)
+    speed = (ref.speed_limit[k] / own.speed_limit).astype(np.float32)
     for names, per_joint in ((TORQUE_CHANNELS, torque), (SPEED_CHANNELS, speed)):
         for name in names:
             col = schema.feature_index(name)
@@ -44,16 +46,16 @@ def _scale(arm: str) -> np.ndarray:
 
 
 def channel_scale(arm: str) -> np.ndarray:
-    """``[12, F]`` factors that turn arm ``arm``'s raw schema snapshot into relative channels
+    """``[2J, F]`` factors that turn arm ``arm``'s raw schema snapshot into relative channels
     (all ones for the reference arm)."""
     return _scale(str(arm))
 
 
 def to_relative(x: np.ndarray, arm: str) -> np.ndarray:
-    """Raw snapshots ``[..., 12, F]`` of arm ``arm`` -> relative channels (a new array)."""
+    """Raw snapshots ``[..., 2J, F]`` of arm ``arm`` -> relative channels (a new array)."""
     return (x * channel_scale(arm)).astype(np.float32)
 
 
 def to_raw(x: np.ndarray, arm: str) -> np.ndarray:
-    """Relative snapshots ``[..., 12, F]`` -> arm ``arm``'s raw readings (a new array)."""
+    """Relative snapshots ``[..., 2J, F]`` -> arm ``arm``'s raw readings (a new array)."""
     return (x / channel_scale(arm)).astype(np.float32)

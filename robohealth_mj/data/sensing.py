@@ -63,15 +63,16 @@ class SensingProfile:
         """The classes in schema order (the index space every model and table shares)."""
         return tuple(c for c in schema.FAULT_CLASSES if c in self.classes)
 
-    def mask(self) -> np.ndarray | None:
-        """``[12, F]`` of 1 (kept) and 0 (zeroed), or None when every channel is kept."""
-        keep = np.zeros((schema.N_NODES, schema.N_FEATURES), np.float32)
+    def mask(self, joints: int = schema.N_JOINTS) -> np.ndarray | None:
+        """``[2J, F]`` of 1 (kept) and 0 (zeroed) on an arm of ``joints`` joints, or None when
+        every channel is kept."""
+        keep = np.zeros((2 * joints, schema.N_FEATURES), np.float32)
         keep[:, :2] = 1.0  # is_joint, is_sensor
         for name in self.joint_channels:  # on the joints and on their copies at the sensor nodes
             keep[:, schema.feature_index(name)] = 1.0
         for name in self.sensor_channels:
-            keep[schema.N_JOINTS :, schema.feature_index(name)] = 1.0
-        keep[: schema.N_JOINTS, schema.SENSOR_CHANNELS] = 1.0  # zero there already
+            keep[joints:, schema.feature_index(name)] = 1.0
+        keep[:joints, schema.SENSOR_CHANNELS] = 1.0  # zero there already
         return None if keep.all() else keep
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import Recording
 from robohealth_mj.data.observability import MOTION_ONLY_FAULTS, MOVING_RAD_S
-from robohealth_mj.schema import FAULT_CLASSES, N_JOINTS, feature_index
+from robohealth_mj.schema import FAULT_CLASSES, feature_index
 
 
 @dataclass
@@ -54,7 +54,8 @@ def joints_moved(rec: Recording, windows: Windows, threshold: float = MOVING_RAD
     vel = feature_index("vel")
     # a joint at a time: a [K, W] gather, not [K, W, J] (a whole corpus at stride 1)
     return np.stack(
-        [np.abs(rec.x[rows, j, vel]).max(axis=1) > threshold for j in range(N_JOINTS)], axis=1
+        [np.abs(rec.x[rows, j, vel]).max(axis=1) > threshold for j in range(rec.graph.n_joints)],
+        axis=1,
     )
 
 
@@ -204,7 +205,8 @@ def label_windows(rec: Recording, window: int, rule: str = "last") -> Recording:
         return rec
     if rule == "visible":
         return _hidden_as_healthy(rec, window)
-    code = rec.fault_class * (N_JOINTS + 1) + (rec.fault_joint + 1)  # one id per (class, joint)
+    per_class = rec.graph.n_joints + 1
+    code = rec.fault_class * per_class + (rec.fault_joint + 1)  # one id per (class, joint)
     codes = np.unique(code)
 
     def rolling(values: np.ndarray, width: int = window) -> np.ndarray:
@@ -227,8 +229,8 @@ def label_windows(rec: Recording, window: int, rule: str = "last") -> Recording:
     ends = rolling(joins, window - 1) == 0  # no break between the window's snapshots
     ends[: window - 1] = False
     sev = total / (np.maximum(carried, 1.0) if rule == "majority" else window)
-    fault_class = np.where(ends, best // (N_JOINTS + 1), rec.fault_class)
-    fault_joint = np.where(ends, best % (N_JOINTS + 1) - 1, rec.fault_joint)
+    fault_class = np.where(ends, best // per_class, rec.fault_class)
+    fault_joint = np.where(ends, best % per_class - 1, rec.fault_joint)
     return replace(
         rec,
         fault_class=fault_class.astype(rec.fault_class.dtype),

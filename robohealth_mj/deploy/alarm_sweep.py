@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj import schema
+from robohealth_mj.arms.description import DEFAULT_ARM
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import Recording, load_recordings
 from robohealth_mj.data.relative import to_raw
@@ -41,6 +42,8 @@ class Decisions:
     window: int
     speed: np.ndarray | None = None  # [T, J] |joint velocity|, for the physically hidden strata
     torque: np.ndarray | None = None  # [T, J] joint torque (effort)
+    joints: tuple[str, ...] = schema.JOINT_NAMES  # the arm's, the joint scores' order
+    arm: str = DEFAULT_ARM  # whose ratings the torques are read against
 
 
 def replay_decisions(model: str | Path, recording: str | Path) -> Decisions:
@@ -78,19 +81,19 @@ def replay_many(model: str | Path, recordings: Sequence[str | Path]) -> list[Dec
         for row, i in enumerate(live.tolist()):
             decided[i][k] = r.status[row] == DECIDED
             probs[i][k], scores[i][k] = r.probs[row], r.joint_scores[row]
-    return [
-        Decisions(
-            decided[i], probs[i], scores[i], _truth(rec), fleet.window, *joint_activity(rec.x)
-        )
-        for i, rec in enumerate(recs)
-    ]
+    out = []
+    for i, rec in enumerate(recs):
+        speed, torque = joint_activity(raws[i])
+        out.append(Decisions(decided[i], probs[i], scores[i], _truth(rec), fleet.window, speed,
+                             torque, joints=rec.graph.joints, arm=fleet.arm))  # fmt: skip
+    return out
 
 
 def _truth(rec: Recording) -> list[FaultLabel]:
     return [
         FaultLabel(
             schema.FAULT_CLASSES[int(c)],
-            schema.JOINT_NAMES[int(j)] if j >= 0 else None,
+            rec.graph.joints[int(j)] if j >= 0 else None,
             float(s),
             bool(a),
         )
@@ -123,9 +126,11 @@ def evaluate_policy(
     if accumulated is None:
         accumulated = accumulate(d, evidence)
     bank = AlarmBank(policy, d.joint_scores.shape[1], 1)
-    ev = OnlineEvaluator(settle_ticks=d.window + policy.clear_after + evidence.clearing_ticks)
+    ev = OnlineEvaluator(
+        arm=d.arm, settle_ticks=d.window + policy.clear_after + evidence.clearing_ticks
+    )
     slot = np.zeros(1, np.int64)
-    classes, joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
+    classes, joints = list(schema.FAULT_CLASSES), list(d.joints)
     for k, truth in enumerate(d.truth):
         diag = HealthDiagnosis(stamp=0.0, stream_id="s", sample_index=k, valid=True)
         if d.decided[k]:

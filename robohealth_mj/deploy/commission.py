@@ -23,7 +23,7 @@ from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data import baseline
-from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings, single_arm
+from robohealth_mj.data.arrays import Recording, expand_paths, single_arm
 from robohealth_mj.data.graphs import GraphSpec, harness_graph
 from robohealth_mj.data.relative import to_raw
 from robohealth_mj.data.sensing import load_profile
@@ -31,8 +31,8 @@ from robohealth_mj.deploy.export import export_checkpoint, file_fingerprint
 from robohealth_mj.deploy.operating_point import Reading, check_recipe, match_operating_point
 from robohealth_mj.deploy.recouple import recouple
 from robohealth_mj.learn.checkpoint import (
-    check_recordings,
     graph_from_checkpoint,
+    load_checked,
     load_checkpoint,
     model_from_checkpoint,
     save_checkpoint,
@@ -47,8 +47,7 @@ SETTLED = 0.1  # a baseline has settled when it moves the residuals within 10 % 
 
 def _healthy(ckpt: dict, paths: list[str] | str, what: str, arm: str | None = None) -> Recording:
     files = expand_paths(paths)
-    check_recordings(ckpt, files)
-    rec = load_recordings(files, arm)
+    rec = load_checked(ckpt, files, arm)
     if what == "healthy" and rec.active.any():
         raise InputError(
             f"{files[0]}: {int(rec.active.sum())} of the {what} ticks carry an active fault; "
@@ -60,7 +59,7 @@ def _healthy(ckpt: dict, paths: list[str] | str, what: str, arm: str | None = No
 def settling(x: np.ndarray, tick_hz: float, final: np.ndarray, delta: np.ndarray) -> list[dict]:
     """For growing prefixes of the healthy data: how far the baseline fitted on that prefix moves
     the residuals from where the final fit moves them, relative to the final shift's size."""
-    b = baseline.basis(x.astype(np.float64))
+    b = baseline.basis(x.astype(np.float64), delta.shape[0])
     size = float(np.sqrt(np.mean(np.square(np.einsum("tjb,jcb->tjc", b, delta))))) or 1.0
     rows = []
     for minutes in MINUTES:
@@ -78,7 +77,7 @@ def reads_residuals(graph: GraphSpec) -> bool:
     if graph.channel_mask is None:
         return True
     columns = [schema.feature_index(name) for name in baseline.RESIDUALS]
-    return bool(graph.channel_mask[: schema.N_JOINTS, columns].any())
+    return bool(graph.channel_mask[: graph.num_joints, columns].any())
 
 
 def contact_record(rec: Recording, arm: str, sensing: str, margin: float | None) -> dict:

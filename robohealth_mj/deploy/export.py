@@ -23,14 +23,14 @@ from torch import nn
 
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_bytes
-from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings, single_arm
+from robohealth_mj.data.arrays import Recording, expand_paths, single_arm
 from robohealth_mj.data.baseline import shift
 from robohealth_mj.data.relative import channel_scale, to_raw
 from robohealth_mj.data.windows import make_windows
 from robohealth_mj.learn.checkpoint import (
-    check_recordings,
     graph_from_checkpoint,
     joint_score_kind,
+    load_checked,
     load_checkpoint,
     model_from_checkpoint,
 )
@@ -57,9 +57,11 @@ class RawInput(nn.Module):
         schema_nodes: int = schema.N_NODES,
         baseline_shift: np.ndarray | None = None,
         channel_scale: np.ndarray | None = None,
+        arm_nodes: int = schema.N_NODES,
     ) -> None:
+        """``arm_nodes``: the arm graph's nodes (2 J), what a raw window carries."""
         super().__init__()
-        self.schema_nodes = schema_nodes
+        self.schema_nodes, self.arm_nodes = schema_nodes, arm_nodes
         self.scaled = channel_scale is not None and not np.all(channel_scale == 1.0)
         if self.scaled:
             self.register_buffer("channel_scale", torch.tensor(np.array(channel_scale)).float())
@@ -82,10 +84,10 @@ class RawInput(nn.Module):
             x = shift(x, self.baseline_shift)
         if self.masked:
             x = x * self.channel_mask
-        if self.schema_nodes < schema.N_NODES:
+        if self.schema_nodes < self.arm_nodes:
             x = x[..., : self.schema_nodes, :]
         if self.mix:
-            j = schema.N_JOINTS
+            j = self.arm_nodes // 2
             sensor = schema.SENSOR_CHANNELS
             mixed = torch.einsum("jm,bwjc->bwmc", self.coupling, x[..., j:, sensor])
             m = self.coupling.shape[1]
@@ -112,12 +114,11 @@ def heldout_recording(
     if not data:
         raise ValueError("no held-out data for the parity check: pass data=PATH")
     files = expand_paths(data)
-    check_recordings(ckpt, files)
-    return load_recordings(files, arm), single_arm(files, arm)
+    return load_checked(ckpt, files, arm), single_arm(files, arm)
 
 
 def heldout_windows(rec: Recording, window: int, count: int, arm: str) -> torch.Tensor:
-    """Up to ``count`` raw windows ``[K, W, 12, F]`` (arm ``arm``'s readings) spread over a
+    """Up to ``count`` raw windows ``[K, W, 2J, F]`` (arm ``arm``'s readings) spread over a
     held-out recording."""
     windows = make_windows(rec, window)
     pick = np.linspace(0, len(windows) - 1, min(count, len(windows))).astype(int)
@@ -126,7 +127,7 @@ def heldout_windows(rec: Recording, window: int, count: int, arm: str) -> torch.
 
 
 def heldout_run(rec: Recording, count: int, arm: str) -> torch.Tensor:
-    """The first ``count`` consecutive raw snapshots ``[count, 12, F]`` of one held-out run."""
+    """The first ``count`` consecutive raw snapshots ``[count, 2J, F]`` of one held-out run."""
     step = np.diff(rec.sample_index, prepend=rec.sample_index[0] - 1)
     same = (rec.run == rec.run[0]) & (step == 1)
     length = int(np.argmin(same)) if not same.all() else len(rec)
@@ -235,6 +236,7 @@ def export_checkpoint(
         graph.schema_nodes,
         graph.baseline_shift,
         channel_scale(target),
+        graph.arm.n_nodes,
     ).eval()
     window = int(ckpt["window"])
     windows = heldout_windows(rec, window, parity_windows, target)
@@ -274,6 +276,7 @@ def export_checkpoint(
         label_set=json.dumps(list(graph.classes)),
         arms=json.dumps(list(ckpt.get("arms") or [])),
         arm=target,
+        arm_graph=graph.arm,
         transfer=json.dumps(bool(ckpt.get("transfer"))),
         **commissioning_metadata(ckpt),
         **incremental,
@@ -318,20 +321,22 @@ def model_metadata(
     outputs: list[str],
     classes: list[str] | None = None,
     joints: list[str] | None = None,
+    arm_graph: schema.ArmGraph = schema.UR_GRAPH,
     **extra: str,
 ) -> dict[str, str]:
-    """The ONNX metadata the runtime checks and reports (all values are strings)."""
+    """The ONNX metadata the runtime checks and reports (all values are strings): the arm graph
+    a raw window must be on (``node_names``, ``edges``) among them."""
     return {
         "model_id": model_id,
         "variant": variant,
         "graph": graph,
         "schema_version": schema.SCHEMA_VERSION,
-        "node_names": json.dumps(list(schema.NODE_NAMES)),
+        "node_names": json.dumps(list(arm_graph.nodes)),
         "feature_names": json.dumps(list(schema.FEATURE_NAMES)),
-        "edges": json.dumps([list(e) for e in schema.EDGES]),
+        "edges": json.dumps([list(e) for e in arm_graph.edges]),
         "window": str(window),
         "classes": json.dumps(classes or list(schema.FAULT_CLASSES)),
-        "joints": json.dumps(joints or list(schema.JOINT_NAMES)),
+        "joints": json.dumps(joints or list(arm_graph.joints)),
         "outputs": json.dumps(outputs),
         **extra,
     }

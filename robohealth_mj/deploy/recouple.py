@@ -41,13 +41,14 @@ BLOCK = 20  # ticks (1 s) averaged per row of the motion estimator: drive noise 
 RIDGE = 0.1
 PRUNE = 0.006  # chosen on five validation placements (studies/stock_arm/results/pool_design.md)
 FITS = ("motion", "reconstruction")
-J, SENSORS = schema.N_JOINTS, schema.SENSOR_CHANNELS
+SENSORS = schema.SENSOR_CHANNELS
 POS, VEL = schema.feature_index("pos"), schema.feature_index("vel")
 
 
 def motion_features(x: np.ndarray) -> np.ndarray:
-    """What a drive's emission follows, from the joint state of snapshots ``[T, 12, F]``:
+    """What a drive's emission follows, from the joint state of snapshots ``[T, 2J, F]``:
     ``[T, D]`` (position, speed and acceleration terms of every joint, products of speeds)."""
+    J = x.shape[1] // 2
     q, qd = x[:, :J, POS].astype(np.float64), x[:, :J, VEL].astype(np.float64)
     qdd = np.gradient(qd, axis=0) if len(qd) > 1 else np.zeros_like(qd)
     speed = np.abs(qd)
@@ -97,6 +98,7 @@ def motion_estimate(
     whose removal grows a sensor's residual sum of squares by less than ``prune`` (relative)
     is dropped from it (0: none)."""
     mask = 1.0 if world.channel_mask is None else world.channel_mask
+    J = world.num_joints
     ref = reference.x[~reference.active] * mask
     packages = ref[:, J:, SENSORS].astype(np.float64)
     flat = packages.reshape(-1, packages.shape[-1])

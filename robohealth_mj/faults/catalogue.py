@@ -21,20 +21,22 @@ class Scenario:
     """One cell of the joint x fault x severity space."""
 
     fault_class: str
-    joint: int
+    joint: int  # the joint's index along the arm's chain
     severity: float
+    joint_name: str | None = None  # the arm's name for it (None: the UR joint of that index)
 
     def __post_init__(self) -> None:
         if self.fault_class not in MODES:
             raise InputError(f"unknown fault class {self.fault_class!r}; known: {list(MODES)}")
-        if not 0 <= self.joint < len(JOINT_NAMES):
+        if self.joint < 0 or (self.joint_name is None and self.joint >= len(JOINT_NAMES)):
             raise InputError(f"fault joint index {self.joint} out of range")
         if not 0.0 <= self.severity <= 1.0:
             raise InputError(f"fault severity {self.severity} outside [0, 1]")
 
     @property
     def label(self) -> FaultLabel:
-        return FaultLabel(self.fault_class, JOINT_NAMES[self.joint], float(self.severity), True)
+        name = JOINT_NAMES[self.joint] if self.joint_name is None else self.joint_name
+        return FaultLabel(self.fault_class, name, float(self.severity), True)
 
 
 class FaultParameters:

@@ -10,13 +10,12 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj.faults.catalogue import Scenario
-from robohealth_mj.schema import N_JOINTS, hop_distance
 
 
 @dataclass
 class TickReadings:
-    """Per-tick readings of one chunk, edited in place: pos/vel/effort ``[n, 6]``, vib ``[n, 6]``,
-    acc ``[n, 6, 3]``, piezo sub-bands ``[n, 6, 3]``, kurtosis ``[n, 6]``."""
+    """Per-tick readings of one chunk, edited in place: pos/vel/effort ``[n, J]``, vib ``[n, J]``,
+    acc ``[n, J, 3]``, piezo sub-bands ``[n, J, 3]``, kurtosis ``[n, J]``."""
 
     pos: np.ndarray
     vel: np.ndarray
@@ -42,9 +41,11 @@ class ReadingFaults:
         self.tick_s = float(tick_s)
         self.torque_limit = np.asarray(torque_limit, dtype=float)
         self.analytic_layer = bool(analytic_layer)
-        self.hops = hop_distance()
+        joints = len(self.torque_limit)
+        chain = np.arange(joints)  # hops along the chain
+        self.hops = np.abs(chain[:, None] - chain[None, :])
         self._interval: int | None = None
-        self._drift = np.zeros((N_JOINTS, 4))
+        self._drift = np.zeros((joints, 4))
         self._drift_sign = np.ones(4)
         self._since_reversal = 1e9
         self._last_vel = 0.0
@@ -52,7 +53,7 @@ class ReadingFaults:
         self._baseline: np.ndarray | None = None
 
     def influence(self, scenario: Scenario, decay: float) -> np.ndarray:
-        """Severity attenuated by hop distance from the target joint, per sensor ``[6]``."""
+        """Severity attenuated by hop distance from the target joint, per sensor ``[J]``."""
         return scenario.severity * np.exp(-decay * self.hops[scenario.joint])
 
     def apply(
@@ -111,9 +112,8 @@ class ReadingFaults:
     def _sensor_noise(self, sc: Scenario, r: TickReadings, rng: np.random.Generator) -> None:
         p = self.physics["sensor_noise"]
         w = self.influence(sc, p["decay"])
-        n = r.vib.shape[0]
-        r.vib[:] = np.abs(r.vib + rng.normal(0.0, 1.0, (n, N_JOINTS)) * w * p["sigma_vib"])
-        r.acc += rng.normal(0.0, 1.0, (n, N_JOINTS, 3)) * (w * p["sigma_acc"])[None, :, None]
+        r.vib[:] = np.abs(r.vib + rng.normal(0.0, 1.0, r.vib.shape) * w * p["sigma_vib"])
+        r.acc += rng.normal(0.0, 1.0, r.acc.shape) * (w * p["sigma_acc"])[None, :, None]
         # Broadband transducer noise spreads over the sub-bands (a third of its power in each).
         sigma_band = (w * p["sigma_vib"] / np.sqrt(r.bands.shape[-1]))[None, :, None]
         r.bands[:] = np.abs(r.bands + rng.normal(0.0, 1.0, r.bands.shape) * sigma_band)
@@ -135,16 +135,15 @@ class ReadingFaults:
             self._since_reversal += self.tick_s
             if chatter < 1e-3:
                 continue
-            r.vib[k] += p["chatter_gain"] * w * chatter * self._jitter(rng, N_JOINTS)
-            kick = -np.sign(v) * p["kick_gain"] * w * chatter * self._jitter(rng, N_JOINTS)
+            r.vib[k] += p["chatter_gain"] * w * chatter * self._jitter(rng, len(self.hops))
+            kick = -np.sign(v) * p["kick_gain"] * w * chatter * self._jitter(rng, len(self.hops))
             r.acc[k, :, 0] += kick  # opposite-axis kick against the reversal
 
     def _signature_friction(self, sc: Scenario, r: TickReadings, rng: np.random.Generator) -> None:
         p = self.analytic["friction"]
         w = self.influence(sc, p["decay"])
         load = np.abs(r.effort[:, sc.joint]) / self.torque_limit[sc.joint]
-        n = r.vib.shape[0]
-        r.vib += p["vib_gain"] * load[:, None] * w[None, :] * self._jitter(rng, (n, N_JOINTS))
+        r.vib += p["vib_gain"] * load[:, None] * w[None, :] * self._jitter(rng, r.vib.shape)
         r.acc[:, :, 2] += p["z_bias"] * w[None, :]
 
     def _signature_jam(self, sc: Scenario, r: TickReadings, rng: np.random.Generator) -> None:
@@ -155,7 +154,7 @@ class ReadingFaults:
             if self._jam_phase < p["period_s"]:
                 continue
             self._jam_phase = 0.0
-            r.vib[k] += p["impulse_gain"] * w * self._jitter(rng, N_JOINTS)
+            r.vib[k] += p["impulse_gain"] * w * self._jitter(rng, len(self.hops))
             direction = rng.normal(size=3)
             direction /= np.linalg.norm(direction)
             r.acc[k] += p["impulse_gain"] * w[:, None] * direction[None, :]

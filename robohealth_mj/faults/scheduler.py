@@ -28,8 +28,10 @@ class Interval:
 class NoFaults:
     """A healthy session."""
 
-    def __init__(self, tick_s: float = 0.05, seed: int = 0) -> None:
-        del tick_s, seed  # same construction signature as the other schedules
+    def __init__(
+        self, tick_s: float = 0.05, seed: int = 0, arm_joints: Sequence[str] | None = None
+    ) -> None:
+        del tick_s, seed, arm_joints  # same construction signature as the other schedules
 
     def interval_at(self, tick: int) -> Interval:
         return Interval(None, 0, 2**62)
@@ -51,12 +53,19 @@ class FaultScheduler:
         classes: Sequence[str] = MODES,
         joints: Sequence[str] = JOINT_NAMES,
         seed: int = 0,
+        arm_joints: Sequence[str] | None = None,
     ) -> None:
-        unknown = [j for j in joints if j not in JOINT_NAMES]
+        """``arm_joints``: the simulated arm's joints (default the UR's); ``joints`` those that
+        fail, by the arm's names (the UR's six, the default, stand for every joint of an arm
+        of other joints)."""
+        arm = tuple(arm_joints or JOINT_NAMES)
+        if tuple(joints) == JOINT_NAMES and arm != JOINT_NAMES:
+            joints = arm
+        unknown = [j for j in joints if j not in arm]
         if unknown:
-            raise InputError(f"unknown joints in faults.joints: {unknown}")
+            raise InputError(f"unknown joints in faults.joints: {unknown}; known: {list(arm)}")
         self.scenarios = [
-            Scenario(c, JOINT_NAMES.index(j), float(s))
+            Scenario(c, arm.index(j), float(s), None if arm == JOINT_NAMES else j)
             for j, c, s in itertools.product(joints, classes, severities)
         ]
         if not self.scenarios:
@@ -112,10 +121,13 @@ class FixedFault:
         onset_s: float = 0.0,
         end_s: float | None = None,
         seed: int = 0,
+        arm_joints: Sequence[str] | None = None,
     ) -> None:
-        if joint not in JOINT_NAMES:
-            raise InputError(f"unknown joint {joint!r}; known: {list(JOINT_NAMES)}")
-        self.scenario_ = Scenario(fault_class, JOINT_NAMES.index(joint), float(severity))
+        arm = tuple(arm_joints or JOINT_NAMES)
+        if joint not in arm:
+            raise InputError(f"unknown joint {joint!r}; known: {list(arm)}")
+        name = None if arm == JOINT_NAMES else joint
+        self.scenario_ = Scenario(fault_class, arm.index(joint), float(severity), name)
         self.onset = _ticks(onset_s, tick_s, "faults.onset_s", allow_zero=True)
         self.end = 2**62 if end_s is None else _ticks(end_s, tick_s, "faults.end_s")
         if self.end <= self.onset:

@@ -48,15 +48,15 @@ def save_checkpoint(
         "variant": variant,
         "schema": {
             "version": schema.SCHEMA_VERSION,
-            "node_names": list(schema.NODE_NAMES),
-            "edges": [list(e) for e in schema.EDGES],
+            "node_names": list(graph.arm.nodes),
+            "edges": [list(e) for e in graph.arm.edges],
             "feature_names": list(schema.FEATURE_NAMES),
         },
         "graph": graph.as_dict(),
         "window": int(window),
         "norm_mean": torch.from_numpy(np.asarray(mean, np.float32)),
         "norm_std": torch.from_numpy(np.asarray(std, np.float32)),
-        "labels": {"classes": list(schema.FAULT_CLASSES), "joints": list(schema.JOINT_NAMES)},
+        "labels": {"classes": list(schema.FAULT_CLASSES), "joints": list(graph.arm.joints)},
         "config": config,
         "code_version": code_version,
         "data_fingerprint": data_fingerprint,
@@ -144,7 +144,14 @@ def graph_from_checkpoint(ckpt: dict[str, Any]) -> GraphSpec:
         int(g.get("schema_nodes", schema.N_NODES)),  # absent before the stock profile: all
         tuple(g.get("classes", schema.FAULT_CLASSES)),
         None if g.get("baseline_shift") is None else np.asarray(g["baseline_shift"], np.float32),
+        checkpoint_arm(ckpt),
+        g.get("coupling_seed"),
     )
+
+
+def checkpoint_arm(ckpt: dict[str, Any]) -> schema.ArmGraph:
+    """The arm graph a checkpoint was trained on (the UR's before schema 3.0)."""
+    return schema.ArmGraph.of_nodes(ckpt["schema"]["node_names"])
 
 
 def joint_score_kind(ckpt: dict[str, Any]) -> str:
@@ -209,17 +216,35 @@ def check_recordings(ckpt: dict[str, Any], files: list) -> None:
         )
 
 
-def check_schema(ckpt: dict[str, Any], source: str) -> None:
-    """Refuse data whose node order or topology differs from what the model was trained on."""
+def load_checked(ckpt: dict[str, Any], files: list, arm: str | None = None):
+    """``files`` as a Recording the model reads (:func:`check_recordings`, then loaded), or one
+    line where they are of another arm graph than the model's."""
+    from robohealth_mj.data.arrays import load_recordings
+
+    check_recordings(ckpt, files)
+    rec = load_recordings(files, arm)
+    check_schema(ckpt, str(files[0]), rec.graph)
+    return rec
+
+
+def check_schema(ckpt: dict[str, Any], source: str, graph: schema.ArmGraph | None = None) -> None:
+    """Refuse a checkpoint of a schema this code does not read, one whose graph is not an arm's,
+    and data (``graph``: the recordings') whose node order or topology differs from what the
+    model was trained on."""
     s = ckpt["schema"]
-    if s["version"] != schema.SCHEMA_VERSION:
+    if s["version"] not in schema.READABLE_VERSIONS:
         raise InputError(
-            f"{source}: schema {schema.SCHEMA_VERSION} here, the checkpoint's is {s['version']}"
+            f"{source}: schema {s['version']} is not one this code reads "
+            f"({', '.join(schema.READABLE_VERSIONS)})"
         )
-    if s["node_names"] != list(schema.NODE_NAMES):
+    try:
+        trained = checkpoint_arm(ckpt)
+    except ValueError as exc:
+        raise InputError(f"{source}: key 'schema.node_names': {exc}") from None
+    if s["edges"] != [list(e) for e in trained.edges]:
+        raise InputError(f"{source}: graph topology differs from the checkpoint's arm graph")
+    if graph is not None and graph != trained:
         raise InputError(
-            f"{source}: node order {list(schema.NODE_NAMES)} differs from the "
-            f"checkpoint's {s['node_names']}"
+            f"{source}: an arm of joints {list(graph.joints)}; the model was trained on "
+            f"{list(trained.joints)}"
         )
-    if s["edges"] != [list(e) for e in schema.EDGES]:
-        raise InputError(f"{source}: graph topology differs from the checkpoint's")

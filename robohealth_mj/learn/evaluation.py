@@ -14,7 +14,7 @@ import torch
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.common.numeric import joint_scores_from_logits, softmax
-from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
+from robohealth_mj.data.arrays import Recording, expand_paths
 from robohealth_mj.data.observability import check_observability, hide_unobservable
 from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.data.windows import (
@@ -25,9 +25,9 @@ from robohealth_mj.data.windows import (
     target_joint_moved,
 )
 from robohealth_mj.learn.checkpoint import (
-    check_recordings,
     graph_from_checkpoint,
     joint_score_kind,
+    load_checked,
     load_checkpoint,
     model_from_checkpoint,
 )
@@ -70,8 +70,7 @@ def score_checkpoint(
         observability, load_profile(graph.sensing).joint_channels if motion else None
     )
     files = expand_paths(data)
-    check_recordings(ckpt, files)
-    rec = graph.relabel(load_recordings(files))
+    rec = graph.relabel(load_checked(ckpt, files))
     rule = labels or str(ckpt["config"].get("labels", "last"))
     rec = label_windows(rec, int(ckpt["window"]), rule)
     dev = pick_device(device)

@@ -74,7 +74,7 @@ class PlacementPool:
         self.noise = float(noise)
         j, m = graph.coupling.shape
         couplings = np.stack([random_coupling(POOL_SEED + k, m, j) for k in range(size)])
-        packages = x[:, schema.N_JOINTS :, schema.SENSOR_CHANNELS].astype(np.float64)
+        packages = x[:, j:, schema.SENSOR_CHANNELS].astype(np.float64)
         ok = packages[healthy]
         self.package_mean = ok.mean(axis=0)  # [J, C]
         centred = ok - self.package_mean

@@ -19,7 +19,7 @@ from mujoco import rollout
 from robohealth_mj.common.seeds import stream
 from robohealth_mj.faults.injector import FaultInjector, healthy_injector
 from robohealth_mj.faults.readings import TickReadings
-from robohealth_mj.schema import FaultLabel
+from robohealth_mj.schema import ArmGraph, FaultLabel
 from robohealth_mj.sim.control import TrackingController
 from robohealth_mj.sim.curriculum import Curriculum
 from robohealth_mj.sim.model import ArmIndex
@@ -67,6 +67,7 @@ class ArmSimulator:
         self.model, self.curriculum = model, curriculum
         self.controller, self.sensors = controller, sensors
         self.index = ArmIndex.of(model)
+        self.graph = ArmGraph(self.index.joints)  # the samples' graph: the arm's own
         self.dt = float(model.opt.timestep)
         self.tick_steps = _whole(1.0 / (tick_hz * self.dt), "physics steps per tick")
         self.tick_s = self.tick_steps * self.dt
@@ -164,7 +165,9 @@ class ArmSimulator:
         ctrl_knots, torque_knots = self.controller.commands(q, qd, qdd)
 
         def per_step(values: np.ndarray) -> np.ndarray:
-            return np.stack([np.interp(step_times, knots, values[:, j]) for j in range(6)], axis=1)
+            return np.stack(
+                [np.interp(step_times, knots, values[:, j]) for j in range(values.shape[1])], axis=1
+            )
 
         return per_step(ctrl_knots), per_step(qd), per_step(torque_knots)
 

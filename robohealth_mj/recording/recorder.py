@@ -23,22 +23,15 @@ from hydra.utils import instantiate
 from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
-from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
+from robohealth_mj.arms.description import DEFAULT_ARM, load_arm, short_name
 from robohealth_mj.common.atomic import atomic_write_json
-from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.errors import USER_ERRORS, InputError
 from robohealth_mj.common.version import code_version
 from robohealth_mj.data.jsonl import format_line, node_features
 from robohealth_mj.data.windows import recorded_run_id
 from robohealth_mj.faults.injector import FaultInjector
 from robohealth_mj.recording.arm import ArmSimulator, TickChunk
-from robohealth_mj.schema import (
-    EDGES,
-    FEATURE_NAMES,
-    JOINT_NAMES,
-    NODE_NAMES,
-    SCHEMA_VERSION,
-    FaultLabel,
-)
+from robohealth_mj.schema import JOINT_NAMES, SCHEMA_VERSION, FaultLabel
 from robohealth_mj.sim.pushes import read_pushes
 from robohealth_mj.sim.twin_file import read_twin_noise
 
@@ -65,7 +58,7 @@ def default_run_id(cfg: DictConfig) -> str:
     if data["session"].get("pushes") == []:  # added later too: out of the id while empty
         del data["session"]["pushes"]
     digest = hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:10]
-    return recorded_run_id(arm_name(cfg), cfg.seed, digest)
+    return recorded_run_id(short_name(arm_name(cfg)), cfg.seed, digest)
 
 
 def arm_name(cfg: DictConfig) -> str:
@@ -77,16 +70,22 @@ def arm_name(cfg: DictConfig) -> str:
 class SessionStats:
     """Running totals that end up in the manifest and the printed summary."""
 
+    joints: tuple[str, ...]  # the arm's, base to tool
     samples: int = 0
-    sq_error: np.ndarray = field(default_factory=lambda: np.zeros(6))
-    max_error: np.ndarray = field(default_factory=lambda: np.zeros(6))
-    saturated_steps: np.ndarray = field(default_factory=lambda: np.zeros(6, dtype=int))
+    sq_error: np.ndarray = field(default_factory=lambda: np.zeros(1))
+    max_error: np.ndarray = field(default_factory=lambda: np.zeros(1))
+    saturated_steps: np.ndarray = field(default_factory=lambda: np.zeros(1, dtype=int))
     max_contacts: int = 0
     visits: list[int] = field(default_factory=list)
     families: dict[str, int] = field(default_factory=dict)
     classes: dict[str, int] = field(default_factory=dict)
-    joints: dict[str, int] = field(default_factory=dict)
+    faulted: dict[str, int] = field(default_factory=dict)
     scenarios: set[tuple[str, str, float]] = field(default_factory=set)
+
+    def __post_init__(self) -> None:
+        n = len(self.joints)
+        self.sq_error, self.max_error = np.zeros(n), np.zeros(n)
+        self.saturated_steps = np.zeros(n, dtype=int)
 
     def add(self, chunk: TickChunk, segment: dict[str, Any], fault: FaultLabel) -> None:
         err = chunk.true_pos - chunk.reference
@@ -101,25 +100,25 @@ class SessionStats:
         self.families[segment["family"]] = self.families.get(segment["family"], 0) + n
         self.classes[fault.fault_class] = self.classes.get(fault.fault_class, 0) + n
         if fault.active:
-            self.joints[fault.joint] = self.joints.get(fault.joint, 0) + n
+            self.faulted[fault.joint] = self.faulted.get(fault.joint, 0) + n
             self.scenarios.add((fault.fault_class, fault.joint, fault.severity))
 
     def as_dict(self) -> dict[str, Any]:
         rms = np.sqrt(self.sq_error / max(self.samples, 1))
         return {
             "samples": self.samples,
-            "tracking_rms_rad": dict(zip(JOINT_NAMES, rms.round(6).tolist(), strict=True)),
+            "tracking_rms_rad": dict(zip(self.joints, rms.round(6).tolist(), strict=True)),
             "tracking_max_rad": dict(
-                zip(JOINT_NAMES, self.max_error.round(6).tolist(), strict=True)
+                zip(self.joints, self.max_error.round(6).tolist(), strict=True)
             ),
             "torque_saturated_steps": dict(
-                zip(JOINT_NAMES, self.saturated_steps.tolist(), strict=True)
+                zip(self.joints, self.saturated_steps.tolist(), strict=True)
             ),
             "max_contacts": self.max_contacts,
             "segments_visited": len(self.visits),
             "samples_per_family": dict(sorted(self.families.items())),
             "samples_per_class": dict(sorted(self.classes.items())),
-            "faulted_samples_per_joint": dict(sorted(self.joints.items())),
+            "faulted_samples_per_joint": dict(sorted(self.faulted.items())),
             "scenarios_covered": len(self.scenarios),
         }
 
@@ -162,23 +161,37 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
     description = load_arm(variation.name)
     nominal = instantiate(cfg.sim, arm=description.name)
     model, arm = variation.draw(nominal, cfg.seed)  # the physics: this session's arm
-    curriculum = instantiate(
+    make_curriculum = instantiate(
         cfg.curriculum,
         seed=cfg.seed,
         rated_payload_kg=description.payload_kg,
         speed_limit_rad_s=description.speed_limit.tolist(),
         _convert_="all",
+        _partial_=True,  # the arm is an object, not config: given to the partial
     )
+    try:
+        curriculum = make_curriculum(arm=description)
+    except USER_ERRORS as exc:  # named as Hydra names a config object it could not build
+        raise InputError(f"config 'curriculum': {exc}") from None
     controller = instantiate(cfg.control, model=nominal)  # the controller: the datasheet's
     sensors = instantiate(cfg.sensors, physics_rate_hz=1.0 / model.opt.timestep, _convert_="all")
-    # the drive's torque sensing resolves the same fraction of its rating on every arm
-    sensors.effort_scale = description.rated_torque / np.asarray(cfg.sim.reference_torque_nm)
+    # the drive's torque sensing resolves the same fraction of its rating on every arm (each
+    # joint against its UR5e counterpart's)
+    ur = dict(zip(JOINT_NAMES, cfg.sim.reference_torque_nm, strict=True))
+    reference = np.array([ur[c] for c in description.ur_counterparts()], dtype=float)
+    sensors.effort_scale = description.rated_torque / reference
     noise = read_twin_noise(cfg.sim.twin, description.name) if cfg.sim.get("twin") else None
     if noise is not None:  # a twin reads its effort as noisily as the real arm's current does
         sensors.effort_scale = noise / sensors.noise.effort
     variation.apply_to_sensors(sensors, arm)
     tick_s = round(1.0 / (cfg.session.tick_hz * model.opt.timestep)) * model.opt.timestep
-    schedule = instantiate(cfg.faults.schedule, tick_s=tick_s, seed=cfg.seed, _convert_="all")
+    schedule = instantiate(
+        cfg.faults.schedule,
+        tick_s=tick_s,
+        seed=cfg.seed,
+        arm_joints=list(description.joint_keys),
+        _convert_="all",
+    )
     params = instantiate(cfg.fault_params, seed=cfg.seed, _convert_="all")
     faults = FaultInjector(
         schedule, params, cfg.faults.fault_model, model, tick_s, cfg.seed, ramp_s=cfg.faults.ramp_s
@@ -220,11 +233,7 @@ def record_session(cfg: DictConfig, out_dir: Path | str) -> RecordingResult:
         "start_time": datetime.now(UTC).isoformat(timespec="seconds"),
         "code_version": code_version(),
         "files": {"graphs": GRAPHS_FILE},
-        "graph": {
-            "nodes": list(NODE_NAMES),
-            "features": list(FEATURE_NAMES),
-            "edges": [list(e) for e in EDGES],
-        },
+        "graph": sim.graph.as_dict(),
         "rates": {"physics_hz": 1.0 / sim.dt, "tick_hz": 1.0 / sim.tick_s},
         "expected_samples": n_ticks,
         "faults": sim.faults.describe(),
@@ -234,7 +243,7 @@ def record_session(cfg: DictConfig, out_dir: Path | str) -> RecordingResult:
         "config": session_config(cfg),
     }
     atomic_write_json(out_dir / MANIFEST_FILE, manifest)
-    stats = SessionStats()
+    stats = SessionStats(sim.graph.joints)
     started = time.perf_counter()
     status, reason = "incomplete", "interrupted"
     progress = tqdm(
@@ -312,7 +321,7 @@ def segment_info(sim: ArmSimulator, chunk: TickChunk) -> dict[str, Any]:
 
 
 def chunk_features(chunk: TickChunk) -> np.ndarray:
-    """Node features ``[n, 12, F]`` of every tick of a chunk, in the schema's channel order."""
+    """Node features ``[n, 2J, F]`` of every tick of a chunk, in the schema's channel order."""
     state = np.stack(
         [chunk.pos, chunk.vel, chunk.effort, chunk.pos_error, chunk.effort_residual], axis=-1
     )
@@ -328,7 +337,7 @@ def chunk_lines(sim: ArmSimulator, chunk: TickChunk, run_id: str) -> list[str]:
     first = sim.tick - len(chunk.t)
     x = chunk_features(chunk)
     return [
-        format_line(run_id, first + k, float(chunk.t[k]), x[k], chunk.fault, segment)
+        format_line(run_id, first + k, float(chunk.t[k]), x[k], chunk.fault, segment, sim.graph)
         for k in range(len(chunk.t))
     ]
 

@@ -1,13 +1,14 @@
 """The fleet runtime: many 20 Hz streams diagnosed in bulk, one batch per tick.
 
 Samples arrive as arrays, one row per sample: ``slots [R]`` (from :meth:`FleetRuntime.register`),
-``sample_index [R]``, ``t [R]``, ``x [R, 12, F]`` (and optionally ``layout_ok [R]``, whether the
-sender's node order is the schema's). Every check is vectorised over the rows, each stream's
-window lives in preallocated arrays (:mod:`robohealth_mj.runtime.incremental`), the model runs
-once per tick on every stream whose window is full, each stream's evidence accumulates over its
-windows (:mod:`robohealth_mj.runtime.evidence`; reset with the window on a gap), and the alarms
-update in bulk on the accumulated probabilities. With ``observability="motion"`` a stream's
-window calls friction and backlash only on joints that moved in it
+``sample_index [R]``, ``t [R]``, ``x [R, 2J, F]`` on the model's arm graph (and optionally
+``layout_ok [R]``, whether the sender's node order is the model's). Every check is vectorised
+over the rows, each stream's window lives in preallocated arrays
+(:mod:`robohealth_mj.runtime.incremental`), the model runs once per tick on every stream whose
+window is full, each stream's evidence accumulates over its windows
+(:mod:`robohealth_mj.runtime.evidence`; reset with the window on a gap), and the alarms update
+in bulk on the accumulated probabilities. With ``observability="motion"`` a stream's window
+calls friction and backlash only on joints that moved in it
 (:mod:`robohealth_mj.data.observability`; the last sample index at which each joint moved is
 kept per stream). A model commissioned with contact thresholds also runs the contact watch
 on every valid row (:mod:`robohealth_mj.runtime.contact`: a push on an arm that holds a pose),
@@ -48,9 +49,6 @@ JOINT_SCORES = ("softmax", "sigmoid")  # how joint logits become scores (ONNX me
 
 _NEVER = -(2**62)  # the sample index at which a joint that has not moved yet last moved
 _VEL = schema.feature_index("vel")
-_FLAGS = np.zeros((schema.N_NODES, 2), np.float32)
-_FLAGS[: schema.N_JOINTS, 0] = 1.0
-_FLAGS[schema.N_JOINTS :, 1] = 1.0
 
 
 @dataclass
@@ -156,7 +154,8 @@ class FleetRuntime:
         self.joint_scores = "softmax"
         self.arm = DEFAULT_ARM  # the arm whose raw readings the model takes
         self.sensing = "full"  # the model's sensing profile (data/sensing.py)
-        self.classes, self.joints = list(schema.FAULT_CLASSES), list(schema.JOINT_NAMES)
+        self.graph = schema.UR_GRAPH  # the arm graph the model reads (its metadata's)
+        self.classes, self.joints = list(schema.FAULT_CLASSES), list(self.graph.joints)
         self.engine: IncrementalEngine | WindowedEngine | None = None
         self.mode = "none"
         self.providers: list[str] = []  # the execution providers the sessions run on
@@ -172,7 +171,7 @@ class FleetRuntime:
         self.last_t = np.full(capacity, -np.inf)
         self.last_index = np.full(capacity, -1, np.int64)
         self.last_seen = np.zeros(capacity, np.int64)
-        self.last_moved = np.full((capacity, schema.N_JOINTS), _NEVER, np.int64)
+        self.last_moved = np.full((capacity, self.graph.n_joints), _NEVER, np.int64)
         self.active = np.zeros(capacity, bool)
         self.ids: dict[str, int] = {}
         self.names: list[str | None] = [None] * capacity
@@ -230,13 +229,8 @@ class FleetRuntime:
 
         from robohealth_mj.runtime.metadata import read_metadata
 
-        meta = read_metadata(path)
-        if meta.get("node_names") != list(schema.NODE_NAMES):
-            raise ValueError("model node order differs from this schema")
-        if meta.get("schema_version") != schema.SCHEMA_VERSION:
-            raise ValueError(
-                f"model schema {meta.get('schema_version')} != {schema.SCHEMA_VERSION}"
-            )
+        meta = read_metadata(path)  # checks the schema version and the arm graph
+        self.graph = meta["arm_graph"]
         options = ort.SessionOptions()
         options.intra_op_num_threads = threads
         # named providers were checked in __init__; else CUDA where present, else the CPU
@@ -271,7 +265,7 @@ class FleetRuntime:
             self.mode = "incremental"
         else:
             self.engine = WindowedEngine(
-                session(str(path)), self.window, schema.N_NODES, schema.N_FEATURES, capacity
+                session(str(path)), self.window, self.graph.n_nodes, schema.N_FEATURES, capacity
             )
             self.mode = "windowed"
         self.model_id = meta["model_id"]
@@ -330,7 +324,7 @@ class FleetRuntime:
         self.last_index = np.concatenate([self.last_index, np.full(n, -1, np.int64)])
         self.last_seen = np.concatenate([self.last_seen, np.zeros(n, np.int64)])
         self.last_moved = np.concatenate(
-            [self.last_moved, np.full((n, schema.N_JOINTS), _NEVER, np.int64)]
+            [self.last_moved, np.full((n, self.graph.n_joints), _NEVER, np.int64)]
         )
         self.active = np.concatenate([self.active, np.zeros(n, bool)])
         self.names += [None] * n
@@ -367,9 +361,10 @@ class FleetRuntime:
         reasons: dict[int, str] = {}
         self.ticks += 1
         x = np.asarray(x, np.float32)
-        if x.shape[1:] != (schema.N_NODES, schema.N_FEATURES):
+        if x.shape[1:] != (self.graph.n_nodes, schema.N_FEATURES):
+            shape = (self.graph.n_nodes, schema.N_FEATURES)
             for k in range(n):
-                reasons[k] = f"x has shape {x.shape[1:]}, not {(schema.N_NODES, schema.N_FEATURES)}"
+                reasons[k] = f"x has shape {x.shape[1:]}, not {shape} (the model's arm graph)"
             return TickResult(slots, sample_index, t, reasons=reasons, **out)
         known = (slots >= 0) & (slots < self.capacity)
         known[known] &= self.active[slots[known]]
@@ -400,7 +395,7 @@ class FleetRuntime:
     def _round(self, rows, slots, index, t, x, known, layout_ok, final, out, reasons) -> float:
         """Rows with distinct slots: validate, buffer, infer (``final`` rows), alarm. Returns
         the model step's ms."""
-        bad = _validate(x, t, known, layout_ok)  # [n] reason code, 0 = fine
+        bad = _validate(x, t, known, layout_ok, self.graph)  # [n] reason code, 0 = fine
         s = np.where(known, slots, 0)
         backwards = (bad == 0) & ((t <= self.last_t[s]) | (index <= self.last_index[s]))
         bad[backwards] = _BACKWARDS
@@ -434,7 +429,7 @@ class FleetRuntime:
         self.last_t[gs], self.last_index[gs] = gt, gi
         xg = x[good]  # one copy of the valid rows for every step below
         if self.observability == "motion":
-            fast = np.abs(xg[:, : schema.N_JOINTS, _VEL]) > MOVING_RAD_S  # [g, J]
+            fast = np.abs(xg[:, : self.graph.n_joints, _VEL]) > MOVING_RAD_S  # [g, J]
             self.last_moved[gs] = np.where(fast, gi[:, None], self.last_moved[gs])
         if self.contact is not None:  # every valid row, before its window is full too
             out["contact"][gr], out["contact_joint"][gr] = self.contact.update(gs, xg)
@@ -549,7 +544,11 @@ def _burst_rank(slots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _validate(
-    x: np.ndarray, t: np.ndarray, known: np.ndarray, layout_ok: np.ndarray | None
+    x: np.ndarray,
+    t: np.ndarray,
+    known: np.ndarray,
+    layout_ok: np.ndarray | None,
+    graph: schema.ArmGraph,
 ) -> np.ndarray:
     """Reason code per row (0 = valid), the first failing check in this order."""
     checks = [
@@ -557,8 +556,8 @@ def _validate(
         np.zeros(len(x), bool) if layout_ok is None else ~layout_ok,
         ~np.isfinite(t),
         ~np.isfinite(x).all(axis=(1, 2)),
-        (x[:, :, :2] != _FLAGS).any(axis=(1, 2)),
-        (x[:, : schema.N_JOINTS, schema.SENSOR_CHANNELS] != 0.0).any(axis=(1, 2)),
+        (x[:, :, :2] != graph.type_flags()).any(axis=(1, 2)),
+        (x[:, : graph.n_joints, schema.SENSOR_CHANNELS] != 0.0).any(axis=(1, 2)),
     ]
     code = np.zeros(len(x), np.int64)
     for value, failed in reversed(list(enumerate(checks, start=1))):
@@ -571,12 +570,12 @@ def _reason(code: int, x: np.ndarray, t: float, index: int, slot: int, fleet: Fl
     if code == _UNKNOWN:
         return f"unknown stream or stream limit ({fleet.max_streams}) reached"
     if code == _LAYOUT:
-        return f"node order differs from the schema's {list(schema.NODE_NAMES)}"
+        return f"node order differs from the model's {list(fleet.graph.nodes)}"
     if code == _TIME:
         return "field 't': not finite"
     if code == _NAN:
         node, feat = np.argwhere(~np.isfinite(x))[0]
-        return f"field 'x[{schema.NODE_NAMES[node]}].{schema.FEATURE_NAMES[feat]}': NaN or Inf"
+        return f"field 'x[{fleet.graph.nodes[node]}].{schema.FEATURE_NAMES[feat]}': NaN or Inf"
     if code == _FLAG:
         return "field 'x.is_joint/is_sensor': node-type indicators do not match the node order"
     if code == _STRAY:

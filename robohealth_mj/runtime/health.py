@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -62,9 +63,20 @@ class HealthTracker:
             raise InputError(f"{path}: not a health state file of version {STATE_VERSION}")
         return state
 
-    def update(self, arm: str, day: float, health: SessionHealth) -> list[JointHealth]:
-        """Add one session's index (at operating ``day``) and return every joint's estimate."""
+    def update(
+        self,
+        arm: str,
+        day: float,
+        health: SessionHealth,
+        joints: Sequence[str] = JOINT_NAMES,
+    ) -> list[JointHealth]:
+        """Add one session's index (at operating ``day``) and return every joint's estimate
+        (``joints``: the arm's, the index's order)."""
         state = self.history(arm)
+        if list(state.get("joints", JOINT_NAMES)) != list(joints) and state["sessions"]:
+            raise InputError(f"{arm}: a history of joints {state.get('joints', JOINT_NAMES)}, "
+                             f"not {list(joints)}")  # fmt: skip
+        state["joints"] = list(joints)
         last = state["sessions"][-1]["day"] if state["sessions"] else None
         if last is not None and day <= last:
             raise InputError(f"{arm}: session day {day} is not after the last one ({last})")
@@ -87,7 +99,7 @@ class HealthTracker:
         days = np.array([s["day"] for s in sessions])
         index = np.array([s["index"] for s in sessions], float)  # [S, J]
         out = []
-        for j, name in enumerate(JOINT_NAMES):
+        for j, name in enumerate(state.get("joints", JOINT_NAMES)):
             rul = self.estimator.estimate(days, index[:, j])
             last = sessions[-1]
             out.append(

@@ -31,7 +31,16 @@ def read_metadata(path: Path | str) -> dict[str, Any]:
             f"'{(missing or ['x'])[0]}' missing)"
         )
     dims = [d.dim_value or d.dim_param for d in proto.graph.input[0].type.tensor_type.shape.dim]
-    expected = [int(raw["window"]), schema.N_NODES, schema.N_FEATURES]
+    try:
+        graph = schema.ArmGraph.of_nodes(json.loads(raw["node_names"]))
+    except (ValueError, TypeError) as exc:
+        raise InputError(f"{path}: metadata key 'node_names': {exc}") from None
+    if raw["schema_version"] not in schema.READABLE_VERSIONS:
+        raise InputError(
+            f"{path}: metadata key 'schema_version': {raw['schema_version']} is not one this "
+            f"code reads ({', '.join(schema.READABLE_VERSIONS)}); export the model again"
+        )
+    expected = [int(raw["window"]), graph.n_nodes, schema.N_FEATURES]
     if proto.graph.input[0].name != "x" or dims[1:] != expected:
         raise InputError(
             f"{path}: input '{proto.graph.input[0].name}' has shape {dims}, expected "
@@ -44,4 +53,5 @@ def read_metadata(path: Path | str) -> dict[str, Any]:
             decoded[key] = json.loads(raw[key])
     if "window" in raw:
         decoded["window"] = int(raw["window"])
+    decoded["arm_graph"] = graph  # the graph a raw window must be on
     return decoded

@@ -249,8 +249,10 @@ class SessionWear:
         self.stream_id, self.day = stream_id, float(cfg.day)
         self.probs: list[list[float]] = []
         self.joints: list[list[float]] = []
+        self.names: list[str] = list(JOINT_NAMES)  # the model's joints (the arm's)
 
     def add(self, d: HealthDiagnosis, joints: list[str]) -> None:
+        self.names = list(joints)
         if d.valid and d.fault_class is not None:
             self.probs.append([d.class_probabilities.get(c, 0.0) for c in FAULT_CLASSES])
             self.joints.append([d.joint_scores[j] for j in joints])
@@ -258,12 +260,12 @@ class SessionWear:
     def finish(self) -> list:
         attribution = attribution_from_probabilities(
             np.array(self.probs).reshape(-1, len(FAULT_CLASSES)),
-            np.array(self.joints).reshape(-1, len(JOINT_NAMES)),
+            np.array(self.joints).reshape(-1, len(self.names)),
         )
         health = session_health(attribution, self.calibration)
         if health.windows == 0:
             raise InputError(f"{self.stream_id}: no decided window this session: no health index")
-        joints = self.tracker.update(self.stream_id, self.day, health)
+        joints = self.tracker.update(self.stream_id, self.day, health, self.names)
         fields = dict(health_fields(joints))
         for j in joints:
             name = j.joint

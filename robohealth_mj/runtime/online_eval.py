@@ -40,7 +40,7 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.arms.description import DEFAULT_ARM
-from robohealth_mj.arms.ratings import rated_torque_nm
+from robohealth_mj.arms.ratings import joint_keys, rated_torque_nm
 from robohealth_mj.data.observability import MOVING_RAD_S
 from robohealth_mj.runtime.runtime import HealthDiagnosis
 from robohealth_mj.schema import FaultLabel
@@ -72,20 +72,23 @@ LOADED_SHARE = 0.05  # RMS torque as a share of the joint's rated torque
 
 
 def joint_activity(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The joints' speeds ``|vel|`` and torques (effort) of snapshots ``x [..., 12, F]``, each
+    """The joints' speeds ``|vel|`` and torques (effort) of snapshots ``x [..., 2J, F]``, each
     ``[..., J]``: what :meth:`OnlineEvaluator.update` takes for the physically hidden strata."""
-    joints = x[..., : schema.N_JOINTS, :]
+    joints = x[..., : x.shape[-2] // 2, :]
     return np.abs(joints[..., schema.feature_index("vel")]), joints[
         ..., schema.feature_index("effort")
     ].copy()
 
 
-def physically_hidden(ep: _Episode, rated_torque: np.ndarray) -> bool | None:
+def physically_hidden(
+    ep: _Episode, rated_torque: np.ndarray, joints: tuple[str, ...] = schema.JOINT_NAMES
+) -> bool | None:
     """Whether nothing about this episode's fault reaches any channel: friction on a joint that
-    never moved, structural weakening of a joint that never carried load (None: not known)."""
+    never moved, structural weakening of a joint that never carried load (None: not known);
+    ``joints``: the arm's, in the order of ``rated_torque``."""
     if ep.peak_speed is None or ep.label.joint is None:
         return None
-    j = schema.JOINT_NAMES.index(ep.label.joint)
+    j = joints.index(ep.label.joint)
     if ep.label.fault_class == "friction":
         return ep.peak_speed < MOVED_SPEED
     if ep.label.fault_class == "struct_weaken":
@@ -142,7 +145,7 @@ class OnlineEvaluator:
             current.last = tick
             self._last_faulted = tick
             if speed is not None and torque is not None and truth.joint is not None:
-                j = schema.JOINT_NAMES.index(truth.joint)
+                j = joint_keys(self.arm).index(truth.joint)
                 current.peak_speed = max(current.peak_speed or 0.0, abs(float(speed[j])))
                 current.torque_sq += float(torque[j]) ** 2
                 current.activity_ticks += 1
@@ -189,7 +192,7 @@ class OnlineEvaluator:
             by_severity[f"{ep.label.severity:g}"].append(ep)
             by_both[f"{ep.label.fault_class}@{ep.label.severity:g}"].append(ep)
             by_joint[f"{ep.label.fault_class}@{ep.label.joint}"].append(ep)
-            hidden = physically_hidden(ep, rated)
+            hidden = physically_hidden(ep, rated, joint_keys(self.arm))
             if hidden is not None:
                 by_visibility["physically_hidden" if hidden else "observable"].append(ep)
         settled_hours = self.settled * self.tick_s / 3600.0

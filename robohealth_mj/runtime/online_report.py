@@ -30,7 +30,8 @@ HEADER = [
 def _detection_grid(by_joint: dict[str, dict[str, Any]]) -> list[str]:
     """Detected / episodes per class (rows) x joint (columns)."""
     classes = sorted({k.split("@")[0] for k in by_joint})
-    joints = list(JOINT_NAMES)
+    named = list(dict.fromkeys(k.split("@", 1)[1] for k in by_joint))  # as they came
+    joints = list(JOINT_NAMES) if set(named) <= set(JOINT_NAMES) else named
     lines = ["| detected | " + " | ".join(joints) + " |", "|---" * (len(joints) + 1) + "|"]
     for c in classes:
         cells = [by_joint.get(f"{c}@{j}") for j in joints]

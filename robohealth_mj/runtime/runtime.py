@@ -169,18 +169,24 @@ class ModelRuntime:
         self._queue.append((slot, s))
         return None
 
-    @staticmethod
-    def _parse(sample: dict | str | GraphSample) -> GraphSample:
+    def _parse(self, sample: dict | str | GraphSample) -> GraphSample:
+        """A sample on the model's arm graph, or SchemaError naming the field."""
+        graph = self.fleet.graph
         if isinstance(sample, GraphSample):
-            if sample.x.shape != (schema.N_NODES, schema.N_FEATURES):
+            if sample.x.shape != (graph.n_nodes, schema.N_FEATURES):
                 raise SchemaError(f"shape {sample.x.shape}", field="x")
+            if sample.graph.nodes != graph.nodes:
+                raise SchemaError(f"nodes of joints {list(sample.graph.joints)}; the model "
+                                  f"reads {list(graph.joints)}", field="nodes")  # fmt: skip
             return sample
         if isinstance(sample, str):
             try:
                 sample = json.loads(sample)
             except json.JSONDecodeError as exc:
                 raise SchemaError(f"invalid JSON ({exc.msg})", field="<json>") from None
-        return validate_sample(sample, source="stream")
+        if self.fleet.engine is None:  # no model: any arm's sample is read as itself
+            return validate_sample(sample, source="stream")
+        return validate_sample(sample, source="stream", graph=graph)
 
     def tick(self) -> list[HealthDiagnosis]:
         """Diagnose every queued sample (one fleet step)."""

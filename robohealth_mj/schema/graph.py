@@ -3,9 +3,16 @@ edges and the schema's version."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import cache, cached_property
+
 import numpy as np
 
-SCHEMA_VERSION = "2.0"  # 2.0: tracking error, torque residual, piezo bands, kurtosis
+SCHEMA_VERSION = "3.0"  # 3.0: the graph is the arm's (any joint count); 2.0: the UR graph
+# Versions a reader takes: 2.0 (tracking error, torque residual, piezo bands, kurtosis) is 3.0 on
+# the six-joint UR graph.
+READABLE_VERSIONS: tuple[str, ...] = ("2.0", "3.0")
 
 JOINT_NAMES: tuple[str, ...] = (
     "shoulder_pan",
@@ -69,33 +76,112 @@ FAULT_CLASSES: tuple[str, ...] = (
 )
 
 
-def _structural_edges() -> tuple[tuple[int, int], ...]:
-    """Kinematic backbone between adjacent joints, then joint <-> own sensor, both directions."""
-    edges: list[tuple[int, int]] = []
-    for i in range(N_JOINTS - 1):
-        edges += [(i, i + 1), (i + 1, i)]
-    for i in range(N_JOINTS):
-        edges += [(i, N_JOINTS + i), (N_JOINTS + i, i)]
-    return tuple(edges)
+@dataclass(frozen=True)
+class ArmGraph:
+    """The graph of one arm: its joints along the chain, base to tool, then one sensor package
+    per joint (``<joint>_sensor``); edges between adjacent joints and between each joint and its
+    package, both directions. The node set and edges come from the arm, so one definition serves
+    a UR's six joints, a Franka's seven and a user's five (schema 3.0)."""
+
+    joints: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        joints = tuple(str(j) for j in self.joints)
+        object.__setattr__(self, "joints", joints)
+        if len(joints) < 2 or len(set(joints)) != len(joints):
+            raise ValueError(f"an arm graph needs two or more distinct joints, got {list(joints)}")
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.joints)
+
+    @property
+    def n_nodes(self) -> int:
+        return 2 * len(self.joints)
+
+    @property
+    def sensors(self) -> tuple[str, ...]:
+        return tuple(f"{name}_sensor" for name in self.joints)
+
+    @property
+    def nodes(self) -> tuple[str, ...]:
+        return self.joints + self.sensors
+
+    @cached_property
+    def edges(self) -> tuple[tuple[int, int], ...]:
+        """Kinematic backbone between adjacent joints, then joint <-> own sensor."""
+        j = self.n_joints
+        out: list[tuple[int, int]] = []
+        for i in range(j - 1):
+            out += [(i, i + 1), (i + 1, i)]
+        for i in range(j):
+            out += [(i, j + i), (j + i, i)]
+        return tuple(out)
+
+    def edge_index(self) -> np.ndarray:
+        """Edges as a PyG-style ``[2, E]`` int64 array."""
+        return np.array(self.edges, dtype=np.int64).T.copy()
+
+    def adjacency(self) -> np.ndarray:
+        """Dense ``[N, N]`` 0/1 adjacency of the structural graph (no self-loops)."""
+        a = np.zeros((self.n_nodes, self.n_nodes), dtype=np.float32)
+        for i, k in self.edges:
+            a[i, k] = 1.0
+        return a
+
+    def hop_distance(self) -> np.ndarray:
+        """Hop distance between joints along the kinematic chain, ``[J, J]``."""
+        idx = np.arange(self.n_joints)
+        return np.abs(idx[:, None] - idx[None, :])
+
+    def type_flags(self) -> np.ndarray:
+        """The ``is_joint``/``is_sensor`` columns every sample carries, ``[N, 2]``."""
+        flags = np.zeros((self.n_nodes, 2), np.float32)
+        flags[: self.n_joints, 0] = 1.0
+        flags[self.n_joints :, 1] = 1.0
+        return flags
+
+    def as_dict(self) -> dict:
+        """What a manifest, a checkpoint and an ONNX file carry of the graph."""
+        return {
+            "joints": list(self.joints),
+            "nodes": list(self.nodes),
+            "features": list(FEATURE_NAMES),
+            "edges": [list(e) for e in self.edges],
+        }
+
+    @classmethod
+    def of_nodes(cls, nodes: Sequence[str]) -> ArmGraph:
+        """The graph whose node list is ``nodes`` (J joints, then their J sensors), or
+        ValueError saying why it is not one."""
+        return _graph_of_nodes(tuple(nodes))
 
 
-EDGES: tuple[tuple[int, int], ...] = _structural_edges()
+@cache
+def _graph_of_nodes(nodes: tuple[str, ...]) -> ArmGraph:
+    if len(nodes) % 2:
+        raise ValueError(f"{len(nodes)} nodes: not J joints followed by their J sensors")
+    graph = ArmGraph(nodes[: len(nodes) // 2])
+    if graph.nodes != nodes:
+        raise ValueError(f"node order {list(nodes)} is not J joints followed by their J sensors")
+    return graph
+
+
+# The UR e-Series graph: every 2.0 recording's, and the default where an arm is not named.
+UR_GRAPH = ArmGraph(JOINT_NAMES)
+EDGES: tuple[tuple[int, int], ...] = UR_GRAPH.edges
 
 
 def edge_index() -> np.ndarray:
-    """Edges as a PyG-style ``[2, E]`` int64 array."""
-    return np.array(EDGES, dtype=np.int64).T.copy()
+    """The UR graph's edges as a PyG-style ``[2, E]`` int64 array."""
+    return UR_GRAPH.edge_index()
 
 
 def adjacency() -> np.ndarray:
-    """Dense ``[N, N]`` 0/1 adjacency of the structural graph (no self-loops)."""
-    a = np.zeros((N_NODES, N_NODES), dtype=np.float32)
-    for i, j in EDGES:
-        a[i, j] = 1.0
-    return a
+    """Dense ``[N, N]`` adjacency of the UR graph."""
+    return UR_GRAPH.adjacency()
 
 
 def hop_distance() -> np.ndarray:
-    """Hop distance between joints along the kinematic chain, ``[J, J]``."""
-    idx = np.arange(N_JOINTS)
-    return np.abs(idx[:, None] - idx[None, :])
+    """Hop distance between the UR graph's joints, ``[J, J]``."""
+    return UR_GRAPH.hop_distance()

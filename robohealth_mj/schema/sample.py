@@ -11,17 +11,14 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj.schema.graph import (
-    EDGES,
     FAULT_CLASSES,
     FEATURE_NAMES,
-    JOINT_NAMES,
     N_FEATURES,
-    N_JOINTS,
-    N_NODES,
-    NODE_NAMES,
-    SCHEMA_VERSION,
+    READABLE_VERSIONS,
     SENSOR_CHANNELS,
     SENSOR_FEATURES,
+    UR_GRAPH,
+    ArmGraph,
 )
 
 
@@ -54,17 +51,18 @@ class FaultLabel:
 
 @dataclass(frozen=True)
 class GraphSample:
-    """One 20 Hz snapshot of the arm as a 12-node graph."""
+    """One 20 Hz snapshot of the arm as a graph of its J joints and J sensor packages."""
 
     recording_run_id: str
     sample_index: int
     t: float
-    x: np.ndarray  # [N_NODES, N_FEATURES]
+    x: np.ndarray  # [N, N_FEATURES], N = 2 J
     fault: FaultLabel
     segment: dict[str, Any]
     # A live sample's header stamp, exactly: ``t`` is it in float seconds, which at epoch times is
     # up to 128 ns off, so a diagnosis stamped from ``t`` would not match the sample it diagnoses.
     stamp_ns: int | None = None
+    graph: ArmGraph = UR_GRAPH  # the arm's graph: x's rows, fault.joint's names
 
 
 # The segment of a sample with no ground truth (a robot's own log or bag): nothing is known of it.
@@ -101,8 +99,16 @@ def _require(obj: dict, key: str, kind: Any, err: Any, prefix: str = "") -> Any:
     return value
 
 
-def validate_sample(obj: Any, *, source: str = "<sample>", line: int | None = None) -> GraphSample:
-    """Check one decoded JSON object against the schema and return it as a GraphSample.
+def validate_sample(
+    obj: Any,
+    *,
+    source: str = "<sample>",
+    line: int | None = None,
+    graph: ArmGraph | None = None,
+) -> GraphSample:
+    """Check one decoded JSON object against the schema and return it as a GraphSample: on
+    ``graph`` when given (a recording's manifest says which), else on the graph its node list
+    names (a 2.0 sample: the UR graph only).
 
     Raises SchemaError naming ``source``, ``line`` and the offending field; nothing is repaired.
     """
@@ -114,9 +120,10 @@ def validate_sample(obj: Any, *, source: str = "<sample>", line: int | None = No
         raise err(f"expected a JSON object, got {type(obj).__name__}")
     # The version first: a recording of another schema fails on that, not on a field it lacks.
     version = _require(obj, "schema_version", str, err)
-    if version != SCHEMA_VERSION:
+    if version not in READABLE_VERSIONS:
         raise err(
-            f"version {version!r} is not the supported {SCHEMA_VERSION!r} (re-record it)",
+            f"version {version!r} is not one of the supported {list(READABLE_VERSIONS)} "
+            "(re-record it)",
             field="schema_version",
         )
     for key, kind in _REQUIRED.items():
@@ -125,30 +132,51 @@ def validate_sample(obj: Any, *, source: str = "<sample>", line: int | None = No
         raise err("must be >= 0", field="sample_index")
     if not math.isfinite(obj["t"]):
         raise err("not finite", field="t")
-    if tuple(obj["nodes"]) != NODE_NAMES:
-        raise err(
-            f"node order {obj['nodes']} differs from the schema's {list(NODE_NAMES)}", field="nodes"
-        )
+    graph = _graph(obj, version, graph, err)
     edges = obj["edge_index"]
     if (
         len(edges) != 2
         or any(not isinstance(r, list) for r in edges)
-        or list(zip(*edges, strict=False)) != list(EDGES)
+        or list(zip(*edges, strict=False)) != list(graph.edges)
     ):
-        raise err("topology differs from the schema's structural graph", field="edge_index")
-    x = _features(obj["x"], err)
-    fault = _fault(obj["fault"], err)
+        raise err("topology differs from the arm's structural graph", field="edge_index")
+    x = _features(obj["x"], graph, err)
+    fault = _fault(obj["fault"], graph, err)
     segment = obj["segment"]
     for key, kind in _SEGMENT_REQUIRED.items():
         _require(segment, key, kind, err, prefix="segment.")
     return GraphSample(
-        obj["recording_run_id"], obj["sample_index"], float(obj["t"]), x, fault, segment
-    )
+        obj["recording_run_id"], obj["sample_index"], float(obj["t"]), x, fault, segment,
+        graph=graph,
+    )  # fmt: skip
 
 
-def _features(rows: list, err: Any) -> np.ndarray:
-    if len(rows) != N_NODES or any(not isinstance(r, list) or len(r) != N_FEATURES for r in rows):
-        raise err(f"expected {N_NODES} rows of {N_FEATURES} features", field="x")
+def _graph(obj: dict, version: str, expected: ArmGraph | None, err: Any) -> ArmGraph:
+    """The sample's graph from its node list: the UR graph for 2.0, any arm's for 3.0; the
+    expected one's where the caller knows it (a recording's manifest)."""
+    nodes = tuple(obj["nodes"])
+    if version == "2.0" and nodes != UR_GRAPH.nodes:
+        raise err(
+            f"node order {list(nodes)} differs from the 2.0 schema's {list(UR_GRAPH.nodes)}",
+            field="nodes",
+        )
+    if expected is not None:
+        if nodes != expected.nodes:
+            raise err(
+                f"node order {list(nodes)} differs from the arm's {list(expected.nodes)}",
+                field="nodes",
+            )
+        return expected
+    try:
+        return ArmGraph.of_nodes(nodes)
+    except (ValueError, TypeError) as exc:
+        raise err(str(exc), field="nodes") from None
+
+
+def _features(rows: list, graph: ArmGraph, err: Any) -> np.ndarray:
+    n = graph.n_nodes
+    if len(rows) != n or any(not isinstance(r, list) or len(r) != N_FEATURES for r in rows):
+        raise err(f"expected {n} rows of {N_FEATURES} features", field="x")
     try:
         x = np.array(rows, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -156,28 +184,25 @@ def _features(rows: list, err: Any) -> np.ndarray:
     bad = np.argwhere(~np.isfinite(x))
     if bad.size:
         node, feat = bad[0]
-        raise err("NaN or Inf", field=f"x[{NODE_NAMES[node]}].{FEATURE_NAMES[feat]}")
-    expected_type = np.zeros((N_NODES, 2))
-    expected_type[:N_JOINTS, 0] = 1.0
-    expected_type[N_JOINTS:, 1] = 1.0
-    if not np.array_equal(x[:, :2], expected_type):
+        raise err("NaN or Inf", field=f"x[{graph.nodes[node]}].{FEATURE_NAMES[feat]}")
+    if not np.array_equal(x[:, :2], graph.type_flags()):
         raise err("node-type indicators do not match the node order", field="x.is_joint/is_sensor")
-    stray = np.argwhere(x[:N_JOINTS, SENSOR_CHANNELS] != 0.0)
+    stray = np.argwhere(x[: graph.n_joints, SENSOR_CHANNELS] != 0.0)
     if stray.size:
         node, feat = stray[0]
-        name = f"x[{NODE_NAMES[node]}].{SENSOR_FEATURES[feat]}"
+        name = f"x[{graph.nodes[node]}].{SENSOR_FEATURES[feat]}"
         raise err("joint nodes must zero the sensor channels", field=name)
     return x.astype(np.float32)
 
 
-def _fault(fault: dict, err: Any) -> FaultLabel:
+def _fault(fault: dict, graph: ArmGraph, err: Any) -> FaultLabel:
     cls = _require(fault, "class", str, err, prefix="fault.")
     if cls not in FAULT_CLASSES:
         raise err(f"unknown class {cls!r}; known: {list(FAULT_CLASSES)}", field="fault.class")
     if "joint" not in fault:
         raise err("missing", field="fault.joint")
     joint = fault["joint"]
-    if joint is not None and joint not in JOINT_NAMES:
+    if joint is not None and joint not in graph.joints:
         raise err(f"unknown joint {joint!r}", field="fault.joint")
     severity = _require(fault, "severity", (int, float), err, prefix="fault.")
     if not (0.0 <= severity <= 1.0):

@@ -85,10 +85,9 @@ class DriveModel:
 
     def for_arm(self, arm: ArmDescription) -> dict[str, dict[str, float]]:
         """Each joint's drive parameters on ``arm``: on a UR arm each joint's own, on any other
-        the UR5e joint of its class (:func:`reference_joint`), scaled by rated torque."""
+        the UR5e joint of its class (``arm.ur_counterparts()``), scaled by rated torque."""
         out = {}
-        for j, joint in enumerate(arm.joint_keys):
-            ref = joint if arm.joint_keys == JOINT_NAMES else reference_joint(arm, j)
+        for j, (joint, ref) in enumerate(zip(arm.joint_keys, arm.ur_counterparts(), strict=True)):
             scale = float(arm.rated_torque[j]) / float(
                 self.reference_torque_nm[JOINT_NAMES.index(ref)]
             )
@@ -97,16 +96,6 @@ class DriveModel:
                 for k, v in self.reference[ref].items()
             }
         return out
-
-
-def reference_joint(arm: ArmDescription, j: int) -> str:
-    """The UR5e joint whose drive joint ``j`` of another arm takes: the last joint the UR5e's
-    last (the tool joint's soft drive), a joint rated at half the arm's largest torque or more a
-    base joint's (shoulder lift), any other a wrist's (wrist 2)."""
-    if j == arm.n_joints - 1:
-        return "wrist_3"
-    big = arm.rated_torque[j] >= 0.5 * float(np.max(arm.rated_torque))
-    return "shoulder_lift" if big else "wrist_2"
 
 
 def build_arm_scene(

@@ -20,10 +20,10 @@ from functools import cache
 
 import numpy as np
 
-from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
+from robohealth_mj.arms.description import DEFAULT_ARM, ArmDescription, load_arm
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.seeds import stream
-from robohealth_mj.schema import N_JOINTS
+from robohealth_mj.schema import JOINT_NAMES
 
 FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place", "hold", "cruise")
 WAVEFORMS = ("sine", "triangle", "compound")
@@ -155,30 +155,35 @@ class Curriculum:
         rated_payload_kg: float | None = None,
         speed_limit_rad_s: Sequence[float] | None = None,
         cruise_repeats: int = CRUISE_REPEATS,
+        arm: ArmDescription | None = None,
     ) -> None:
         """``payload_fraction`` of the arm's rated payload is the nominal payload the payload
         scales multiply; ``amplitude_rad`` is for a joint whose speed limit is
         ``reference_speed_rad_s``, and each joint's scales with its own limit over that, so every
-        arm moves at the same fraction of its limits (arm defaults: the UR5e's)."""
+        arm moves at the same fraction of its limits (arm defaults: the UR5e's).
+
+        The per-joint values (``amplitude_rad``, ``center_jitter_rad``, ``home``) are the UR's
+        six; on an ``arm`` of other joints each joint takes its UR counterpart's
+        (``arm.ur_counterparts()``) and the arm's own home, unless J values are given. Where a
+        joint's range is limited, its sweep and jitter shrink to fit 90 % of it."""
         if not speed_scales or not payload_scales:
             raise InputError("curriculum needs at least one speed scale and one payload scale")
         if segment_s < 2.0 * blend_s:
             raise InputError(f"segment_s ({segment_s}) must be >= 2 * blend_s ({blend_s})")
-        for name, vec in (
-            ("amplitude_rad", amplitude_rad),
-            ("center_jitter_rad", center_jitter_rad),
-            ("home", home),
-        ):
-            if len(vec) != N_JOINTS:
-                raise InputError(f"curriculum.{name} needs {N_JOINTS} values, got {len(vec)}")
+        description = load_arm(DEFAULT_ARM) if arm is None else arm
+        self.n_joints = description.n_joints
+        self._counterparts = [JOINT_NAMES.index(c) for c in description.ur_counterparts()]
+        amplitude_rad = self._per_joint("amplitude_rad", amplitude_rad)
+        center_jitter_rad = self._per_joint("center_jitter_rad", center_jitter_rad)
+        own_home = description.joint_keys != JOINT_NAMES and len(home) != self.n_joints
+        home = description.home_pose() if own_home else self._per_joint("home", home)
         self.speed_scales = [float(s) for s in speed_scales]
         self.payload_scales = [float(p) for p in payload_scales]
-        default = load_arm(DEFAULT_ARM)
-        rated = default.payload_kg if rated_payload_kg is None else float(rated_payload_kg)
-        limits = default.speed_limit if speed_limit_rad_s is None else speed_limit_rad_s
+        rated = description.payload_kg if rated_payload_kg is None else float(rated_payload_kg)
+        limits = description.speed_limit if speed_limit_rad_s is None else speed_limit_rad_s
         if not 0.0 < payload_fraction <= 1.0:
             raise InputError(f"curriculum.payload_fraction: in (0, 1], got {payload_fraction}")
-        if len(limits) != N_JOINTS or not reference_speed_rad_s > 0:
+        if len(limits) != self.n_joints or not reference_speed_rad_s > 0:
             raise InputError("curriculum: speed limits need one positive value per joint")
         self.nominal_payload_kg = float(payload_fraction) * rated
         self.speed_ratio = np.asarray(limits, dtype=float) / float(reference_speed_rad_s)
@@ -194,6 +199,7 @@ class Curriculum:
             raise InputError(f"payload_ramp_s ({payload_ramp_s}) must be in [0, blend_s]")
         self.payload_ramp_s = float(payload_ramp_s)
         self.amplitude = self.amplitude * self.speed_ratio
+        self._fit_ranges(description.position_limit)
         unknown = sorted(set(families) - set(FAMILIES))
         if unknown or not families:
             raise InputError(f"curriculum.families must be a non-empty subset of {FAMILIES}")
@@ -205,25 +211,53 @@ class Curriculum:
         self.segments = self._enumerate()
         self._cache: dict[int, ScheduledSegment] = {}
 
+    def _per_joint(self, name: str, values: Sequence[float]) -> np.ndarray:
+        """``values`` for this arm's joints: J of them as given, the UR's six by counterpart."""
+        vec = np.asarray(values, dtype=float)
+        if len(vec) == self.n_joints:
+            return vec
+        if len(vec) == len(JOINT_NAMES):
+            return vec[self._counterparts]
+        raise InputError(
+            f"curriculum.{name} needs {self.n_joints} values (or the UR's six), got {len(vec)}"
+        )
+
+    def _fit_ranges(self, position_limit: np.ndarray) -> None:
+        """Shrink each limited joint's sweep and jitter so the home plus both fits 90 % of its
+        half-range (a UR's +-360 deg joints keep theirs)."""
+        half = 0.5 * (position_limit[:, 1] - position_limit[:, 0])
+        need = self.amplitude + self.jitter
+        room = np.where(np.isfinite(half), 0.9 * half, np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            factor = np.where(need > room, room / need, 1.0)
+        self.amplitude = self.amplitude * factor
+        self.jitter = self.jitter * factor
+
     def _enumerate(self) -> list[Segment]:
         speeds, payloads = self.speed_scales, self.payload_scales
         out: list[Segment] = []
-        for joint, speed, payload in itertools.product(range(N_JOINTS), speeds, payloads):
+        for joint, speed, payload in itertools.product(range(self.n_joints), speeds, payloads):
             out.append(Segment(len(out), "single_joint", "sine", (joint,), speed, payload))
-        pairs = list(itertools.combinations(range(N_JOINTS), 2))
+        pairs = list(itertools.combinations(range(self.n_joints), 2))
         for (p, pair), (s, speed) in itertools.product(enumerate(pairs), enumerate(speeds)):
             payload = payloads[(p + s) % len(payloads)]
             out.append(Segment(len(out), "joint_pair", "sine", pair, speed, payload))
         for wave, speed, payload in itertools.product(WAVEFORMS, speeds, payloads):
-            out.append(Segment(len(out), "whole_arm", wave, tuple(range(N_JOINTS)), speed, payload))
+            out.append(
+                Segment(len(out), "whole_arm", wave, tuple(range(self.n_joints)), speed, payload)
+            )
         for task, speed, payload in itertools.product(TASKS, speeds, payloads):
             out.append(
-                Segment(len(out), "pick_place", task, tuple(range(N_JOINTS)), speed, payload)
+                Segment(len(out), "pick_place", task, tuple(range(self.n_joints)), speed, payload)
             )
         for speed, payload in itertools.product(speeds, payloads):
-            out.append(Segment(len(out), "hold", "rest", tuple(range(N_JOINTS)), speed, payload))
+            out.append(
+                Segment(len(out), "hold", "rest", tuple(range(self.n_joints)), speed, payload)
+            )
         for _, speed, payload in itertools.product(range(self.cruise_repeats), speeds, payloads):
-            out.append(Segment(len(out), "cruise", "movej", tuple(range(N_JOINTS)), speed, payload))
+            out.append(
+                Segment(len(out), "cruise", "movej", tuple(range(self.n_joints)), speed, payload)
+            )
         return [s for s in out if s.family in self.families]
 
     def __len__(self) -> int:
@@ -238,7 +272,7 @@ class Curriculum:
             n = len(self.segments)
             segment = self.segments[int(self._order(visit // n)[visit % n])]
             rng = stream("curriculum.segment", self.seed, visit)
-            center = self.home + rng.uniform(-1.0, 1.0, N_JOINTS) * self.jitter
+            center = self.home + rng.uniform(-1.0, 1.0, self.n_joints) * self.jitter
             start = self.home if visit == 0 else self.scheduled(visit - 1).center
             self._cache[visit] = ScheduledSegment(
                 visit, segment, start, center, visit * self.segment_s
@@ -253,17 +287,19 @@ class Curriculum:
         return self.nominal_payload_kg * self.scheduled(visit).segment.payload_scale
 
     def waypoints(self, visit: int) -> np.ndarray:
-        """A pick_place segment's poses ``[K, 6]``, from its start to its centre: over the pick,
+        """A pick_place segment's poses ``[K, J]``, from its start to its centre: over the pick,
         down, up, over the place (a palletising layer's next cell), down, up, centre."""
         sched = self.scheduled(visit)
         rng = stream("curriculum.pick_place", self.seed, visit)
-        pick = sched.center + rng.uniform(-0.4, 0.4, N_JOINTS) * self.amplitude
+        pick = sched.center + rng.uniform(-0.4, 0.4, self.n_joints) * self.amplitude
         if sched.segment.waveform == "palletise":  # cells of a 3 x 2 layer, in turn
             cell = visit % 6
-            place = self.home + np.array([0.5 + 0.2 * (cell % 3), 0.1 * (cell // 3), 0, 0, 0, 0])
+            offset = np.zeros(self.n_joints)  # the base turns to the cell, the shoulder reaches
+            offset[:2] = 0.5 + 0.2 * (cell % 3), 0.1 * (cell // 3)
+            place = self.home + offset
         else:
-            place = sched.center + rng.uniform(-0.4, 0.4, N_JOINTS) * self.amplitude
-        lift = np.asarray(LIFT_RAD)
+            place = sched.center + rng.uniform(-0.4, 0.4, self.n_joints) * self.amplitude
+        lift = self._per_joint("lift", LIFT_RAD)
         return np.stack(
             [sched.start_pose, pick + lift, pick, pick + lift, place + lift, place, place + lift,
              sched.center]
@@ -288,12 +324,14 @@ class Curriculum:
         return out
 
     def via_pose(self, visit: int) -> np.ndarray:
-        """A cruise segment's turning pose ``[6]``: its centre plus a seeded draw within
+        """A cruise segment's turning pose ``[J]``: its centre plus a seeded draw within
         ``CRUISE_STROKE_RAD``, so the two moves (start to via, via to centre) are long; drawn in
         towards the midpoint of start and centre until both moves fit 95 % of the segment."""
         sched = self.scheduled(visit)
         rng = stream("curriculum.cruise", self.seed, visit)
-        via = sched.center + rng.uniform(-1.0, 1.0, N_JOINTS) * np.asarray(CRUISE_STROKE_RAD)
+        via = sched.center + rng.uniform(-1.0, 1.0, self.n_joints) * self._per_joint(
+            "stroke", CRUISE_STROKE_RAD
+        )
         middle = 0.5 * (sched.start_pose + sched.center)
         while sum(d for d, _ in self._cruise_timings(visit, via)) > self._cruise_room():
             via = middle + 0.9 * (via - middle)
@@ -332,21 +370,21 @@ class Curriculum:
             "whole_arm": self.whole_factor,
             "pick_place": 0.0,  # its motion is its waypoints
         }[segment.family]
-        amp = np.zeros(N_JOINTS)
+        amp = np.zeros(self.n_joints)
         idx = list(segment.joints)
         amp[idx] = self.amplitude[idx] * factor
         return amp
 
     def _phase(self, segment: Segment) -> np.ndarray:
-        phase = np.zeros(N_JOINTS)
+        phase = np.zeros(self.n_joints)
         if segment.family == "joint_pair":
             phase[segment.joints[1]] = np.pi / 2
         elif segment.family == "whole_arm":
-            phase[:] = np.arange(N_JOINTS) * np.pi / 3
+            phase[:] = np.arange(self.n_joints) * np.pi / 3
         return phase
 
     def position(self, visit: int, t: np.ndarray) -> np.ndarray:
-        """Reference link angles ``[len(t), 6]`` at session times ``t`` within one visit."""
+        """Reference link angles ``[len(t), J]`` at session times ``t`` within one visit."""
         sched = self.scheduled(visit)
         seg = sched.segment
         tau = np.asarray(t, dtype=float)[:, None] - sched.t_start

@@ -127,6 +127,7 @@ class ArmIndex:
     effort_sensor: np.ndarray  # [J]
     payload_body: int
     torque_limit: np.ndarray
+    joints: tuple[str, ...] = ()  # the joints' names (the servos'), base to tool
 
     @classmethod
     def of(cls, model: mujoco.MjModel) -> ArmIndex:
@@ -150,6 +151,7 @@ class ArmIndex:
             effort_sensor=np.array([int(s.adr[0]) for s in eff]),
             payload_body=model.body("payload").id,
             torque_limit=model.actuator_forcerange[actuators, 1].copy(),
+            joints=tuple(keys),
         )
 
     def set_link_pose(self, data: mujoco.MjData, q: np.ndarray) -> None:

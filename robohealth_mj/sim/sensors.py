@@ -24,7 +24,6 @@ import numpy as np
 from scipy import signal
 
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.schema import N_JOINTS
 
 BROADBAND_HZ = (20.0, 400.0)
 SUB_BANDS_HZ: tuple[tuple[float, float], ...] = ((20.0, 80.0), (80.0, 200.0), (200.0, 450.0))
@@ -93,10 +92,11 @@ class SensorPackage:
         ]
         self.noise = noise if isinstance(noise, NoiseFloor) else NoiseFloor(**(noise or {}))
         # this arm's own transducers (sim/variation.py): sensitivity and noise factor per joint
-        self.gain = np.ones(N_JOINTS)
-        self.noise_scale = np.ones(N_JOINTS)
+        # (one value: every joint's alike, on an arm of any joint count)
+        self.gain = np.ones(1)
+        self.noise_scale = np.ones(1)
         # the torque sensing's floor per joint relative to the UR5e's (its rating over the UR5e's)
-        self.effort_scale = np.ones(N_JOINTS)
+        self.effort_scale = np.ones(1)
 
     def reset(self) -> None:
         for f in self.filters:
@@ -109,22 +109,22 @@ class SensorPackage:
     def process(
         self, acc: np.ndarray, tick_steps: int, rng: np.random.Generator | None = None
     ) -> tuple[np.ndarray, PiezoTick]:
-        """High-rate accelerations ``[steps, 6, 3]`` -> tick-mean acceleration ``[ticks, 6, 3]``
+        """High-rate accelerations ``[steps, J, 3]`` -> tick-mean acceleration ``[ticks, J, 3]``
         (noise-free; :meth:`add_noise` adds its floor) and the piezo channels of each tick (with
         the transducer noise drawn from ``rng``; noise-free when ``rng`` is None)."""
         steps = acc.shape[0]
         if steps % tick_steps:
             raise ValueError(f"{steps} steps is not a whole number of {tick_steps}-step ticks")
-        ticks = steps // tick_steps
+        ticks, joints = steps // tick_steps, acc.shape[1]
         acc = acc * self.gain[None, :, None]  # each package's sensitivity
-        flat = acc.reshape(steps, N_JOINTS * 3)
-        scale = np.repeat(self.noise_scale, 3)[None, :]
+        flat = acc.reshape(steps, joints * 3)
+        scale = np.repeat(np.broadcast_to(self.noise_scale, (joints,)), 3)[None, :]
         piezo = (
             flat if rng is None else flat + rng.normal(0.0, self.piezo_sigma(), flat.shape) * scale
         )
 
-        def per_tick(filtered: np.ndarray) -> np.ndarray:  # [ticks, tick_steps, 6, 3]
-            return filtered.reshape(ticks, tick_steps, N_JOINTS, 3)
+        def per_tick(filtered: np.ndarray) -> np.ndarray:  # [ticks, tick_steps, J, 3]
+            return filtered.reshape(ticks, tick_steps, joints, 3)
 
         square = np.square(per_tick(self.filters[0](piezo)))
         second = square.mean(axis=1)  # per axis [ticks, 6, 3]
@@ -135,7 +135,7 @@ class SensorPackage:
             np.square(per_tick(f(piezo))).mean(axis=1).sum(axis=-1) for f in self.filters[1:]
         ]
         bands = np.sqrt(np.stack(band_power, axis=-1))
-        acc_mean = acc.reshape(ticks, tick_steps, N_JOINTS, 3).mean(axis=1)
+        acc_mean = acc.reshape(ticks, tick_steps, joints, 3).mean(axis=1)
         return acc_mean, PiezoTick(np.sqrt(power), bands, kurtosis)
 
     def add_noise(

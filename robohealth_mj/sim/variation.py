@@ -18,12 +18,9 @@ import numpy as np
 
 from robohealth_mj.arms.description import DEFAULT_ARM, known_arms
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.resources import is_arm_file
 from robohealth_mj.common.seeds import stream
-from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.model import ArmIndex
-
-LINKS = ("shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link",
-         "wrist_3_link")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -39,10 +36,10 @@ class ArmVariation:
     sensor_gain: float = 0.0  # each sensor package's sensitivity (accelerometer and piezo)
     sensor_noise: float = 0.0  # each sensor package's noise floor
     seed: int | None = None  # the arm's own seed (None: the session's), to run one arm twice
-    name: str = DEFAULT_ARM  # which arm (a folder of assets/) this session's copy is of
+    name: str = DEFAULT_ARM  # which arm (a folder of assets/, or a user's URDF) this copy is of
 
     def __post_init__(self) -> None:
-        if self.name not in known_arms():
+        if not is_arm_file(self.name) and self.name not in known_arms():
             raise InputError(
                 f"arm.name: unknown arm {self.name!r}; known: {', '.join(known_arms())}"
             )
@@ -65,6 +62,11 @@ class ArmVariation:
         rng = stream("sim.variation", seed if self.seed is None else self.seed)
         arm = copy.copy(model)
         idx = ArmIndex.of(arm)
+        joints = idx.joints
+        # each joint moves its own link: the body its motor joint sits in
+        links = tuple(
+            arm.body(arm.jnt_bodyid[arm.joint(f"{j}_deflection").id]).name for j in joints
+        )
 
         def factors(spread: float, n: int) -> np.ndarray:
             return rng.uniform(1.0 - spread, 1.0 + spread, n)  # drawn even at 0: stable stream
@@ -76,23 +78,23 @@ class ArmVariation:
             ("stiffness", arm.tendon_stiffness, idx.tendon),
             ("armature", arm.dof_armature, idx.motor_dof),
         ):
-            f = factors(getattr(self, name), len(JOINT_NAMES))
+            f = factors(getattr(self, name), len(joints))
             values[where] *= f
-            drawn[name] = {j: round(float(v), 5) for j, v in zip(JOINT_NAMES, f, strict=True)}
-        f = factors(self.mass, len(LINKS))
-        for link, k in zip(LINKS, f, strict=True):
+            drawn[name] = {j: round(float(v), 5) for j, v in zip(joints, f, strict=True)}
+        f = factors(self.mass, len(links))
+        for link, k in zip(links, f, strict=True):
             body = arm.body(link).id
             arm.body_mass[body] *= k
             arm.body_inertia[body] *= k
-        drawn["mass"] = {link: round(float(v), 5) for link, v in zip(LINKS, f, strict=True)}
+        drawn["mass"] = {link: round(float(v), 5) for link, v in zip(links, f, strict=True)}
         for name in ("sensor_gain", "sensor_noise"):  # applied by the sensor package
-            f = factors(getattr(self, name), len(JOINT_NAMES))
-            drawn[name] = {j: round(float(v), 5) for j, v in zip(JOINT_NAMES, f, strict=True)}
+            f = factors(getattr(self, name), len(joints))
+            drawn[name] = {j: round(float(v), 5) for j, v in zip(joints, f, strict=True)}
         return arm, drawn
 
     @staticmethod
     def apply_to_sensors(sensors, drawn: dict) -> None:
         """Give ``sensors`` (a SensorPackage) this arm's transducers (nothing for the nominal)."""
         if "sensor_gain" in drawn:
-            sensors.gain = np.array([drawn["sensor_gain"][j] for j in JOINT_NAMES])
-            sensors.noise_scale = np.array([drawn["sensor_noise"][j] for j in JOINT_NAMES])
+            sensors.gain = np.array(list(drawn["sensor_gain"].values()))
+            sensors.noise_scale = np.array(list(drawn["sensor_noise"].values()))

@@ -19,7 +19,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, sosfiltfilt
 
-from robohealth_mj.arms.description import DEFAULT_ARM, load_arm
+from robohealth_mj.arms.description import DEFAULT_ARM, ArmDescription, load_arm
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.seeds import stream
 from robohealth_mj.schema import N_JOINTS
@@ -68,10 +68,17 @@ class ReplayCurriculum:
         seed: int = 0,
         rated_payload_kg: float | None = None,
         speed_limit_rad_s: Sequence[float] | None = None,
+        arm: ArmDescription | None = None,
     ) -> None:
         """``files``: the arm's healthy logs (positions in rad); ``speed_scales``: each log's
         replay runs this much faster (drawn per log and pass); ``payload_kg``: the payload the
-        program carries; ``hold_s``: after each log the arm holds still for up to this long."""
+        program carries; ``hold_s``: after each log the arm holds still for up to this long;
+        ``arm``: the simulated arm (a UR controller's log has six joints: one of six)."""
+        if arm is not None and arm.n_joints != N_JOINTS:
+            raise InputError(
+                f"curriculum=replay plays a UR controller's six-joint logs; the arm "
+                f"{arm.name} has {arm.n_joints} joints"
+            )
         if not files:
             raise InputError("curriculum.files: name at least one log to replay")
         if not speed_scales or min(speed_scales) <= 0:

@@ -11,9 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-RESULTS = (
-    Path(__file__).resolve().parents[2] / "results" / "ablation_models"
-)  # its tables live there
+RESULTS = Path(__file__).resolve().parent / "results"  # its tables live there
 rows = list(csv.DictReader((RESULTS / "ablation.csv").open()))
 labels = [r["change"] for r in rows]
 acc = [float(r["accuracy"]) for r in rows]

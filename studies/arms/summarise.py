@@ -30,8 +30,8 @@ from robohealth_mj.reporting.markdown import heading
 
 ROOT = Path(__file__).resolve().parents[2]
 OUT = ROOT / "outputs" / "campaign_arms"
-RESULTS = ROOT / "results" / "arms"
-ARMS = ("ur3e", "ur5e", "ur10e", "ur16e", "ur20", "ur30")  # the rows, where a campaign has them
+RESULTS = Path(__file__).resolve().parent / "results"
+ARMS = ("ur3e", "ur5e", "ur10e", "ur16e", "ur20", "ur30", "fr3", "iiwa14", "gen3", "xarm7")  # rows
 TICK_S = 0.05
 
 

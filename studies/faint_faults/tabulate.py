@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-RESULTS = Path(__file__).resolve().parents[2] / "results" / "faint_faults"  # its tables live there
+RESULTS = Path(__file__).resolve().parent / "results"  # its tables live there
 ROWS = [
     ("before: headline, window alarms (runtime before this issue)",
      "../fleet/online_eval_heldout900", "../fleet/online_eval_healthy903"),

@@ -17,7 +17,7 @@ import numpy as np
 from robohealth_mj.common.atomic import atomic_write_text
 from robohealth_mj.reporting.statistics import mean_pm_std
 
-RESULTS = Path(__file__).resolve().parents[2] / "results" / "stock"  # its tables live there
+RESULTS = Path(__file__).resolve().parent / "results"  # its tables live there
 
 RUNS = Path(sys.argv[1] if len(sys.argv) > 1 else "outputs/thesis_physics/structural")
 MECHANICAL = ("backlash", "friction", "jam", "struct_weaken")

@@ -21,7 +21,7 @@ from robohealth_mj.deploy.commission import commission
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
 from robohealth_mj.reporting.statistics import mean_pm_std
 
-RESULTS = Path(__file__).resolve().parents[2] / "results" / "stock"  # its tables live there
+RESULTS = Path(__file__).resolve().parent / "results"  # its tables live there
 
 CORPUS = Path(sys.argv[1] if len(sys.argv) > 1 else "outputs/corpus/standard")
 RUNS = Path(sys.argv[2] if len(sys.argv) > 2 else "outputs/thesis_physics/structural/stock/C0")

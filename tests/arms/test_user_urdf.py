@@ -5,6 +5,9 @@ each thing a serial arm cannot be is one line naming the element."""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import mujoco
 import numpy as np
 import pytest
@@ -140,3 +143,94 @@ def test_a_missing_rating_may_come_from_the_ratings_file(tmp_path):
                                                         'velocity="2.5"'),
                      ratings="joints: {j3: {effort: 25}}\n")  # fmt: skip
     assert load_arm(str(path)).rated_torque[2] == 25.0
+
+
+@pytest.fixture(scope="module")
+def toy_deployed(tmp_path_factory) -> dict[str, Path]:
+    """The five-joint arm through the entry points: four short sessions recorded with
+    ``arm=<file>``, a small model trained on three and exported."""
+    from robohealth_mj.export import main as export_main
+    from robohealth_mj.record import main as record_main
+    from robohealth_mj.train import main as train_main
+
+    root = tmp_path_factory.mktemp("toy")
+    urdf, corpus, run = write_arm(root), root / "corpus", root / "run"
+    fast = ["session.progress=false", "faults.schedule.fault_s=1.0",
+            "faults.schedule.healthy_s=1.0", "faults.schedule.severities=[0.9]",
+            "faults.schedule.joints=[j2,j4]", "session.passes=1"]  # fmt: skip
+    for name, seed in {"train_a": 1, "train_b": 2, "train_c": 3, "heldout": 4}.items():
+        record_main([f"arm={urdf}", *fast, f"seed={seed}", f"session.out_dir={corpus / name}"])
+    train_main([f"data.train=[{corpus}/train_*]", f"data.evaluate.heldout={corpus}/heldout",
+                "data.evaluate.probe=null", "trainer.progress=false", "window=8",
+                "variant=stgnn_fixed", "model.hidden=8", "trainer.epochs=1",
+                f"out_dir={run}"])  # fmt: skip
+    export_main([f"ckpt={run / 'best.ckpt'}", f"out={run / 'model.onnx'}"])
+    return {"urdf": urdf, "heldout": corpus / "heldout", "onnx": run / "model.onnx"}
+
+
+@pytest.mark.slow
+def test_a_five_joint_users_arm_goes_through_record_train_export_and_monitor(
+    toy_deployed, tmp_path
+):
+    """``arm=<your.urdf>`` downstream: recordings on the arm's own five-joint graph, a model
+    trained and exported on it, the monitor diagnosing it joint by joint (by the file's names)."""
+    from robohealth_mj.monitor import main as monitor_main
+    from robohealth_mj.runtime.metadata import read_metadata
+
+    urdf = toy_deployed["urdf"]
+    manifest = json.loads((toy_deployed["heldout"] / "manifest.json").read_text())
+    assert manifest["schema_version"] == "3.0" and manifest["arm"] == str(urdf.resolve())
+    assert manifest["graph"]["joints"] == ["j1", "j2", "j3", "j4", "j5"]
+    assert manifest["recording_run_id"].startswith("toy-s4-")
+    assert set(manifest["stats"]["faulted_samples_per_joint"]) == {"j2", "j4"}
+    meta = read_metadata(toy_deployed["onnx"])
+    assert meta["joints"] == ["j1", "j2", "j3", "j4", "j5"] and meta["arm_graph"].n_nodes == 10
+    assert meta["arm"] == str(urdf.resolve())
+
+    out = tmp_path / "online.json"
+    monitor_main([f"model={toy_deployed['onnx']}", f"file={toy_deployed['heldout']}",
+                  "evaluate=true", f"out={out}", "quiet=true"])  # fmt: skip
+    online = json.loads(out.read_text())
+    assert online["decided_ticks"] > 0 and online["episodes"] > 0
+    assert {k.split("@")[1] for k in online["alarms_by_class_and_joint"]} == {"j2", "j4"}
+
+
+@pytest.mark.slow
+def test_a_mixed_fleet_decides_each_arm_as_its_own_fleet_would(toy_deployed, deployed):
+    """A six-joint UR5e model and the five-joint arm's in one process: every row of each arm
+    gets the decision its arm's fleet alone gives it, and a row of one arm's graph sent to the
+    other's model is flagged, not read."""
+    from robohealth_mj.data.arrays import load_recordings
+    from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
+    from robohealth_mj.runtime.mixed import MixedFleet, Rows
+
+    models = {"ur5e": deployed["structural_onnx"], "toy": toy_deployed["onnx"]}
+    data = {"ur5e": load_recordings([deployed["heldout"]]).x[:60],
+            "toy": load_recordings([toy_deployed["heldout"] / "graphs.jsonl"]).x[:60]}  # fmt: skip
+    data["toy"] = data["toy"] / _toy_scale(toy_deployed["urdf"])  # the raw readings again
+    mixed = MixedFleet(models, capacity=4, max_streams=4)
+    alone = {k: FleetRuntime(str(m), strict=True, capacity=4, max_streams=4)
+             for k, m in models.items()}  # fmt: skip
+    slots = {k: mixed.register(k, [f"{k}_a", f"{k}_b"]) for k in models}
+    own = {k: alone[k].register([f"{k}_a", f"{k}_b"]) for k in models}
+    decided = 0
+    for tick in range(len(data["toy"])):
+        x = {k: np.stack([data[k][tick], data[k][(tick + 7) % 60]]) for k in models}
+        index, t = np.full(2, tick), np.full(2, 0.05 * (tick + 1))
+        both = mixed.step({k: Rows(slots[k], index, t, x[k]) for k in models})
+        for k in models:
+            single = alone[k].step(own[k], index, t, x[k])
+            np.testing.assert_array_equal(both[k].status, single.status)
+            np.testing.assert_allclose(both[k].probs, single.probs, atol=1e-6)
+            np.testing.assert_allclose(both[k].joint_scores, single.joint_scores, atol=1e-6)
+            decided += int((both[k].status == DECIDED).sum())
+    assert decided > 100 and mixed.member("toy").joints == ["j1", "j2", "j3", "j4", "j5"]
+    wrong = mixed.step({"toy": Rows(slots["toy"][:1], np.array([99]), np.array([9.0]),
+                                    data["ur5e"][:1])})["toy"]  # fmt: skip
+    assert "not (10, 15)" in wrong.reasons[0]
+
+
+def _toy_scale(urdf: Path) -> np.ndarray:
+    from robohealth_mj.data.relative import channel_scale
+
+    return channel_scale(str(urdf.resolve()))

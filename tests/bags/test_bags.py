@@ -51,7 +51,7 @@ def test_jsonl_to_bag_to_samples_is_the_identity(deployed, bag):
     assert info["storage_identifier"] == "mcap" and info["version"] == 8  # what Humble reads
     custom = info["custom_data"]
     assert custom["robohealth_mj.manifest"] == json.dumps(manifest, sort_keys=True)
-    assert custom["robohealth_mj.schema_version"] == "2.0"
+    assert custom["robohealth_mj.schema_version"] == schema.SCHEMA_VERSION == "3.0"
     assert not bag.with_name(bag.name + ".partial").exists()
     for x, y in zip(a, b, strict=True):
         np.testing.assert_allclose(y.x, x.x, rtol=0, atol=1e-6)
@@ -432,7 +432,7 @@ def bad_files(deployed, tmp_path_factory) -> dict[str, Path]:
         ("truncated_ckpt", "evaluate ckpt={f} data={heldout}", ["truncated.ckpt", "unreadable"]),
         ("tampered_ckpt", "export ckpt={f}", ["tampered.ckpt", "altered"]),
         ("unchecked_ckpt", "evaluate ckpt={f} data={heldout}", ["unchecked.ckpt", "'sha256'"]),
-        ("schema_ckpt", "evaluate ckpt={f} data={heldout}", ["schema.ckpt", "schema 2.0", "1.0"]),
+        ("schema_ckpt", "evaluate ckpt={f} data={heldout}", ["schema.ckpt", "(2.0, 3.0)", "1.0"]),
         ("topology_ckpt", "export ckpt={f}", ["topology.ckpt", "topology"]),
         ("not_onnx", "monitor model={f} source=replay file={heldout}", ["not.onnx", "not an ONNX"]),
         ("shape_onnx", "monitor model={f} source=replay file={heldout}", ["shape.onnx", "'x'"]),

@@ -32,6 +32,7 @@ def test_the_structural_graph_is_the_schema_s_and_leaves_snapshots_as_they_are()
         "adjacency": schema.adjacency().tolist(), "num_joints": 6, "coupling": None,
         "sensing": "full", "channel_mask": None, "schema_nodes": 12,
         "classes": list(schema.FAULT_CLASSES), "baseline_shift": None,
+        "joints": list(schema.JOINT_NAMES), "coupling_seed": None,
     }  # fmt: skip
 
 
@@ -85,9 +86,9 @@ def test_a_one_sensor_coupling_file_is_a_column(tmp_path):
 @pytest.mark.parametrize(
     "matrix, message",
     [
-        (np.ones((5, 4)), r"coupling must be \[6, M\], got \(5, 4\)"),
-        (np.ones((6, 0)), r"coupling must be \[6, M\], got \(6, 0\)"),
-        (np.ones(6), r"coupling must be \[6, M\], got \(6,\)"),
+        (np.ones((1, 4)), r"coupling must be \[J, M\] \(a row per joint\), got \(1, 4\)"),
+        (np.ones((6, 0)), r"coupling must be \[J, M\] \(a row per joint\), got \(6, 0\)"),
+        (np.ones(6), r"coupling must be \[J, M\] \(a row per joint\), got \(6,\)"),
         (-DEFAULT_C0, "must be >= 0"),
         (np.vstack([np.zeros((1, 4)), np.ones((5, 4))]), "every joint must reach a sensor"),
     ],
@@ -99,6 +100,13 @@ def test_a_bad_coupling_file_names_itself_and_the_problem(tmp_path, matrix, mess
     with pytest.raises(ValueError, match=message) as info:
         load_coupling(path)
     assert str(info.value).startswith(f"{path}: ")
+
+
+def test_a_coupling_of_another_joint_count_is_refused_on_the_arm(tmp_path):
+    path = tmp_path / "c.npy"
+    np.save(path, np.ones((5, 4)))
+    with pytest.raises(ValueError, match="the coupling has 5 rows, one per joint; the arm has 6"):
+        harness_graph(coupling_file=str(path))
 
 
 def test_coupling_correlation_needs_one_row_per_joint():

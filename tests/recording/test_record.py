@@ -40,7 +40,8 @@ def test_a_120_s_session_has_2400_valid_samples_and_a_complete_manifest(record_c
     on_disk = json.loads((tmp_path / MANIFEST_FILE).read_text())
     assert on_disk["status"] == "complete"
     assert on_disk["sample_count"] == on_disk["expected_samples"] == 2400
-    assert on_disk["schema_version"] == schema.SCHEMA_VERSION == "2.0"
+    assert on_disk["schema_version"] == schema.SCHEMA_VERSION == "3.0"
+    assert on_disk["graph"]["nodes"] == list(schema.UR_GRAPH.nodes)  # the UR5e's own graph
     assert on_disk["config"]["seed"] == 11
     assert on_disk["code_version"]
     assert on_disk["arm"] == on_disk["arm_ratings"]["arm"] == "ur5e"  # the arm's name, by its key

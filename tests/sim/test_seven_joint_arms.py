@@ -11,7 +11,6 @@ import pytest
 
 from robohealth_mj.arms.chain import gravity_torques
 from robohealth_mj.arms.description import load_arm
-from robohealth_mj.sim.builder import reference_joint
 from robohealth_mj.sim.model import build_model
 
 SEVEN = ("fr3", "iiwa14", "gen3", "xarm7")
@@ -56,24 +55,33 @@ def test_the_models_gravity_torques_are_the_descriptions(name):
 
 @pytest.mark.parametrize("name", SEVEN)
 def test_a_held_pose_with_the_rated_payload_stays_put_at_the_time_step(name):
+    """Home (each joint mid-range: the forearm out, loaded) with the rated payload, under the
+    servo and the controller's feed-forward as the recorder drives it."""
+    from robohealth_mj.sim.control import TrackingController
+
     arm, model = load_arm(name), build_model(name)
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
     model.body_mass[model.body("payload").id] = arm.payload_kg
+    controller = TrackingController(build_model(name))
+    controller.set_payload(arm.payload_kg)
+    home, rest = arm.home_pose()[None], np.zeros((1, arm.n_joints))
+    data.ctrl[:] = controller.commands(home, rest, rest)[0][0]
     for _ in range(3000):  # 3 s at 1 kHz under the servo
         mujoco.mj_step(model, data)
     assert not any(w.number for w in data.warning) and np.all(np.isfinite(data.qpos))
     assert np.max(np.abs(data.qvel)) < 1e-2
     moved = data.qpos[::2] + data.qpos[1::2] - model.key("home").qpos[::2]
-    assert np.max(np.abs(moved)) < 0.02  # rad: the servo holds the weight (the drives give)
+    assert np.max(np.abs(moved)) < 2e-3  # rad: the servo holds the weight
 
 
 def test_another_arms_joints_take_the_ur5e_drive_of_their_class():
     fr3 = load_arm("fr3")  # 87 N m x 4, 12 N m x 3
-    assert [reference_joint(fr3, j) for j in range(7)] == [
+    assert list(fr3.ur_counterparts()) == [
         "shoulder_lift", "shoulder_lift", "shoulder_lift", "shoulder_lift", "wrist_2", "wrist_2",
         "wrist_3",
     ]  # fmt: skip
+    assert load_arm("ur10e").ur_counterparts() == load_arm("ur5e").joint_keys  # each its own
 
 
 @pytest.mark.parametrize("name", SEVEN)
@@ -93,3 +101,20 @@ def test_the_index_and_the_nominal_model_serve_any_joint_count(name):
     )  # fmt: skip
     with pytest.raises(ValueError, match=r"shape \(7,\)"):
         model_gravity(np.zeros(6), arm=name)
+
+
+@pytest.mark.parametrize("name", SEVEN)
+def test_record_arm_records_the_arms_seven_joint_graph(name, record_cfg, tmp_path):
+    """``record arm=<arm>``: a session on the arm's own graph, its joints by the maker's names,
+    every line valid, the fault schedule over its seven joints, tracking in the UR5e's range."""
+    from robohealth_mj.data.read import read_samples
+    from robohealth_mj.recording.recorder import record_session
+
+    arm = load_arm(name)
+    result = record_session(record_cfg(f"arm={name}", "session.duration_s=3"), tmp_path)
+    graph = result.manifest["graph"]
+    assert graph["joints"] == list(arm.joint_keys) and len(graph["nodes"]) == 14
+    samples = list(read_samples(tmp_path / "graphs.jsonl"))
+    assert len(samples) == 60 and all(s.graph.joints == arm.joint_keys for s in samples)
+    assert result.manifest["faults"]["schedule"]["scenarios_per_pass"] == 7 * 6 * 3
+    assert max(result.manifest["stats"]["tracking_rms_rad"].values()) < 2e-3

@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from robohealth_mj.arms.description import load_arm
 from robohealth_mj.common.config import compose_config
 from robohealth_mj.recording.recorder import build_simulator
 from robohealth_mj.sim.model import build_model
-from robohealth_mj.sim.variation import LINKS, ArmVariation
+from robohealth_mj.sim.variation import ArmVariation
 
 SPREAD = ArmVariation(friction=0.3, damping=0.3, stiffness=0.1, armature=0.1, mass=0.15)
 
@@ -29,7 +30,7 @@ def test_the_drawn_arm_is_the_seeds_and_within_its_spreads():
     wrist = nominal.body("wrist_1_link").id
     ratio = a.body_mass[wrist] / nominal.body_mass[wrist]
     assert ratio == pytest.approx(drawn_a["mass"]["wrist_1_link"], abs=1e-5)
-    assert set(drawn_a["mass"]) == set(LINKS)
+    assert set(drawn_a["mass"]) == set(load_arm("ur5e").link_bodies)
     again = ArmVariation(**{**SPREAD.spreads(), "seed": 7}).draw(nominal, 99)[1]
     assert again == drawn_a  # the arm's own seed: the same arm in another session
     assert nominal.dof_frictionloss[0] == 3.0  # the nominal model is left as it was
