@@ -99,7 +99,7 @@ def run_tool(
         returned.append(task(cfg))
 
     app = hydra.main(config_path=HYDRA_CONF, config_name=name, version_base="1.3")(job)
-    args = [_arm_file(a) for a in (sys.argv[1:] if argv is None else list(argv))]
+    args = [o for a in (sys.argv[1:] if argv is None else list(argv)) for o in arm_override(a)]
     checked = _check_before_hydra(name, args)
     before = os.environ.get("HYDRA_FULL_ERROR")
     os.environ["HYDRA_FULL_ERROR"] = "1"
@@ -129,13 +129,14 @@ def run_tool(
     return returned[-1] if returned else None
 
 
-def _arm_file(arg: str) -> str:
-    """``arm=<your.urdf>`` is the arm group's ``name`` set to the file (absolute, so it reads
-    back from any directory): a file is not one of the group's options."""
+def arm_override(arg: str) -> list[str]:
+    """``arm=<your.urdf>`` is the arm group's option ``ur5e`` with its ``name`` set to the file
+    (absolute, so it reads back from any directory): a file is not one of the group's options.
+    Any other argument as it is."""
     key, _, value = arg.partition("=")
     if key in ("arm", "+arm") and is_arm_file(value):
-        return f"arm.name={Path(value).resolve()}"
-    return arg
+        return [f"{key}=ur5e", f"arm.name={Path(value).resolve()}"]
+    return [arg]
 
 
 _FLAGS_WITH_VALUE = ("--config-dir", "-cd", "--config-path", "-cp", "--config-name", "-cn",

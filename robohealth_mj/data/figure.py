@@ -7,12 +7,12 @@ from pathlib import Path
 import numpy as np
 
 from robohealth_mj.data.read import read_samples
-from robohealth_mj.schema import FAULT_CLASSES, JOINT_NAMES, N_JOINTS, feature_index
+from robohealth_mj.schema import FAULT_CLASSES, feature_index
 
 _VIB_ACC = [feature_index(name) for name in ("vib", "acc_x", "acc_y", "acc_z")]
 
 
-def _episodes(path: Path) -> dict[str, tuple[int, np.ndarray, np.ndarray]]:
+def _episodes(path: Path) -> dict[str, tuple[str, np.ndarray, np.ndarray]]:
     """Per fault class, the highest-severity episode: (joint, faulted traces, healthy traces).
 
     Traces are ``[T, 4]`` (vib, acc x/y/z) of the target sensor; the healthy reference is the
@@ -24,20 +24,20 @@ def _episodes(path: Path) -> dict[str, tuple[int, np.ndarray, np.ndarray]]:
     start = 0
     for k in range(1, len(samples) + 1):
         if k == len(samples) or labels[k] != labels[start]:
-            cls, joint, sev = labels[start]
+            cls, _, sev = labels[start]
             if cls != "none" and sev > best.get(cls, (-1.0, 0, 0))[0]:
                 best[cls] = (sev, start, k)
             start = k
     out = {}
     for cls, (_, a, b) in best.items():
-        joint = JOINT_NAMES.index(labels[a][1])
-        node = N_JOINTS + joint
+        graph = samples[a].graph
+        node = graph.n_joints + graph.joints.index(labels[a][1])
         faulted = np.array([samples[i].x[node, _VIB_ACC] for i in range(a, b)])
         after = range(b, min(len(samples), b + (b - a)))
         healthy = np.array(
             [samples[i].x[node, _VIB_ACC] for i in after if not samples[i].fault.active]
         )
-        out[cls] = (joint, faulted, healthy)
+        out[cls] = (labels[a][1], faulted, healthy)
     return out
 
 
@@ -62,7 +62,7 @@ def plot_signatures(path: Path | str, out: Path | str) -> Path:
         ax_v, ax_a = axes[row]
         ax_v.plot(t_h, healthy[:, 0], color="0.6", lw=1, label="healthy")
         ax_v.plot(t_f, faulted[:, 0], color="C3", lw=1, label=cls)
-        ax_v.set_ylabel(f"{cls}\n@{JOINT_NAMES[joint]}", fontsize=8)
+        ax_v.set_ylabel(f"{cls}\n@{joint}", fontsize=8)
         for axis, colour in zip(range(3), ("C0", "C1", "C2"), strict=True):
             mean_h = healthy[:, 1 + axis].mean() if len(healthy) else 0.0
             ax_a.plot(t_h, healthy[:, 1 + axis] - mean_h, color="0.6", lw=0.8)

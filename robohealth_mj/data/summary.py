@@ -24,13 +24,14 @@ class FileSummary:
     severities: dict[str, Counter] = field(default_factory=lambda: defaultdict(Counter))
     runs: dict[str, dict[str, Any]] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
+    arm_joints: tuple[str, ...] = JOINT_NAMES  # the recording's arm's, base to tool
 
     def as_dict(self) -> dict[str, Any]:
         return {
             "path": self.path,
             "samples": self.samples,
             "classes": {c: self.classes.get(c, 0) for c in FAULT_CLASSES},
-            "faulted_per_joint": {j: self.joints.get(j, 0) for j in JOINT_NAMES},
+            "faulted_per_joint": {j: self.joints.get(j, 0) for j in self.arm_joints},
             "severities": {
                 c: {str(k): v for k, v in sorted(s.items())}
                 for c, s in sorted(self.severities.items())
@@ -46,6 +47,7 @@ def summarize_file(path: Path | str) -> FileSummary:
     summary = FileSummary(str(path))
     scenarios: dict[str, set] = defaultdict(set)
     for s in read_samples(path):
+        summary.arm_joints = s.graph.joints
         summary.samples += 1
         summary.classes[s.fault.fault_class] += 1
         run = summary.runs.setdefault(
@@ -70,7 +72,7 @@ def gate(summary: FileSummary, min_samples: int = 400, min_joint_share: float = 
     """Reasons a file must not be used; empty when it passes.
 
     ``min_joint_share``: every joint must carry at least this fraction of a uniform share of the
-    faulted samples (0.5 = half of 1/6).
+    faulted samples (0.5 = half of 1/J).
     """
     problems = []
     if summary.samples < min_samples:
@@ -80,10 +82,10 @@ def gate(summary: FileSummary, min_samples: int = 400, min_joint_share: float = 
         problems.append(f"classes missing: {', '.join(missing)}")
     faulted = sum(summary.joints.values())
     if faulted:
-        floor = min_joint_share * faulted / len(JOINT_NAMES)
+        floor = min_joint_share * faulted / len(summary.arm_joints)
         thin = [
             f"{j} ({summary.joints.get(j, 0)})"
-            for j in JOINT_NAMES
+            for j in summary.arm_joints
             if summary.joints.get(j, 0) < floor
         ]
         if thin:

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 from omegaconf import DictConfig
 
-from robohealth_mj.common.config import compose_config
+from robohealth_mj.common.config import arm_choice, arm_override, compose_config
 
 
 def localisation_tint(joint_scores: dict[str, float]) -> np.ndarray:
@@ -35,9 +35,12 @@ def render_episode(cfg: DictConfig) -> list:
     from robohealth_mj.recording.recorder import build_simulator, chunk_features
     from robohealth_mj.runtime.runtime import ModelRuntime
 
+    runtime = ModelRuntime(cfg.model)
+    arm = arm_choice(cfg) or (runtime.fleet.arm if runtime.fleet.engine is not None else "ur5e")
     record = compose_config(
         "record",
         [
+            *arm_override(f"arm={arm}"),
             "session.progress=false",
             f"seed={cfg.seed}",
             "session.chunk_s=0.05",
@@ -50,7 +53,6 @@ def render_episode(cfg: DictConfig) -> list:
         ],
     )
     sim = build_simulator(record)
-    runtime = ModelRuntime(cfg.model)
     view = EpisodeRenderer(sim.model, cfg.width, cfg.height, cfg.camera)
     every = max(1, round(1.0 / (cfg.fps * sim.tick_s)))
     frames, png_dir = [], Path(cfg.png_dir) if cfg.png_dir else None
@@ -60,7 +62,8 @@ def render_episode(cfg: DictConfig) -> list:
     for k, chunk in enumerate(sim.run(round(cfg.duration_s / sim.tick_s))):
         x = chunk_features(chunk)[0]
         d = runtime.process(
-            "render", format_line("render", k, float(chunk.t[0]), x, chunk.fault, segment)
+            "render",
+            format_line("render", k, float(chunk.t[0]), x, chunk.fault, segment, sim.graph),
         )
         if k % every:
             continue

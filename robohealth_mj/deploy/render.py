@@ -18,8 +18,6 @@ import mujoco
 import numpy as np
 from PIL import Image, ImageDraw
 
-from robohealth_mj.schema import JOINT_NAMES
-
 HEALTHY_RGBA = np.array([0.49, 0.678, 0.8, 1.0])
 FAULT_RGBA = np.array([0.95, 0.15, 0.1, 1.0])
 
@@ -29,7 +27,8 @@ class JointTint:
 
     def __init__(self, model: mujoco.MjModel) -> None:
         self.model = model
-        self.geoms = [model.geom(f"{j}_housing").id for j in JOINT_NAMES]
+        joints = [model.actuator(k).name for k in range(model.nu)]  # one servo per joint
+        self.geoms = [model.geom(f"{j}_housing").id for j in joints]
         model.geom_matid[self.geoms] = -1  # let geom_rgba decide the colour
 
     def apply(self, scores: Sequence[float] | None) -> None:

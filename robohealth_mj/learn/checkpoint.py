@@ -63,6 +63,11 @@ def save_checkpoint(
         "best_epoch": int(best_epoch),
         **(extra or {}),
     }
+    write_checkpoint(path, payload)
+
+
+def write_checkpoint(path: Path | str, payload: dict[str, Any]) -> None:
+    """``payload`` with its checksum, written atomically."""
     payload["sha256"] = checkpoint_digest(payload)
     buffer = io.BytesIO()
     torch.save(payload, buffer)

@@ -63,8 +63,13 @@ class ArmSimulator:
         chunk_s: float = 1.0,
         faults: FaultInjector | None = None,
         pushes: list[Push] | None = None,
+        torque_sensors: bool = False,
     ) -> None:
+        """``torque_sensors``: the arm's joints carry torque sensors (an FR3's, an iiwa's, a
+        Gen3's), so its controller reports the torque on the link side of each drive and its
+        model of that torque, not the motor's (see :meth:`link_torque`)."""
         self.model, self.curriculum = model, curriculum
+        self.torque_sensors = bool(torque_sensors)
         self.controller, self.sensors = controller, sensors
         self.index = ArmIndex.of(model)
         self.graph = ArmGraph(self.index.joints)  # the samples' graph: the arm's own
@@ -102,6 +107,18 @@ class ArmSimulator:
         self.model.body_mass[self.index.payload_body] = payload
         self.controller.set_payload(payload)
 
+    def link_torque(self, qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:
+        """``[n, J]`` what a joint torque sensor reads: the torque the drive's output carries
+        to the link, the passive force of its compliance (stiffness outside the backlash band,
+        damping) on the deflection hinge, from the states ``qpos [n, nq]``, ``qvel [n, nv]``;
+        with the model's present values, so a weakened or loose drive reads as it is."""
+        idx, m = self.index, self.model
+        twist = qpos[:, idx.deflection_qpos]
+        low, high = m.tendon_lengthspring[idx.tendon, 0], m.tendon_lengthspring[idx.tendon, 1]
+        stretch = twist - np.clip(twist, low, high)
+        rate = qvel[:, idx.deflection_dof]
+        return -m.tendon_stiffness[idx.tendon] * stretch - m.tendon_damping[idx.tendon] * rate
+
     @property
     def time(self) -> float:
         return self.tick * self.tick_s
@@ -131,7 +148,7 @@ class ArmSimulator:
         steps = n_ticks * self.tick_steps
         first = self.tick * self.tick_steps
         step_times = (first + np.arange(steps)) * self.dt
-        ctrl, ref_velocity, model_torque = self._controls(visit, step_times)
+        ctrl, ref_velocity, model_torque, model_link = self._controls(visit, step_times)
         forces = self.faults.torques(self._interval, step_times, ref_velocity, self.model.nv)
         controls, spec = [ctrl, forces], _CONTROL_SPEC
         if self.pushes:  # only then: the rollout's inputs grow by six per body
@@ -150,26 +167,28 @@ class ArmSimulator:
         state, sensordata = state[0], sensordata[0]
         self.tick += n_ticks
         at_tick = slice(self.tick_steps - 1, None, self.tick_steps)
-        return self._readings(visit, state, sensordata, model_torque[at_tick])
+        expected = model_link if self.torque_sensors else model_torque
+        return self._readings(visit, state, sensordata, expected[at_tick])
 
     def _controls(
         self, visit: int, step_times: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Commands, reference velocities and the controller's model torques for every physics
-        step (inverse dynamics at knots on a global grid, interpolated)."""
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Commands, reference velocities and the controller's model torques, motor side and
+        link side, for every physics step (inverse dynamics at knots on a global grid,
+        interpolated)."""
         knot_dt = self.controller.knot_dt
         k0 = int(np.floor(step_times[0] / knot_dt + 1e-9))
         k1 = int(np.ceil(step_times[-1] / knot_dt - 1e-9))
         knots = np.arange(k0, max(k1, k0 + 1) + 1) * knot_dt
         q, qd, qdd = self.curriculum.reference(visit, knots)
-        ctrl_knots, torque_knots = self.controller.commands(q, qd, qdd)
+        ctrl_knots, torque_knots, link_knots = self.controller.commands(q, qd, qdd)
 
         def per_step(values: np.ndarray) -> np.ndarray:
             return np.stack(
                 [np.interp(step_times, knots, values[:, j]) for j in range(values.shape[1])], axis=1
             )
 
-        return per_step(ctrl_knots), per_step(qd), per_step(torque_knots)
+        return per_step(ctrl_knots), per_step(qd), per_step(torque_knots), per_step(link_knots)
 
     def _readings(
         self, visit: int, state: np.ndarray, sensordata: np.ndarray, model_torque: np.ndarray
@@ -181,13 +200,12 @@ class ArmSimulator:
         t = state[at_tick, 0]
         true_pos = qpos[:, idx.motor_qpos] + qpos[:, idx.deflection_qpos]
         vel = qvel[:, idx.motor_dof] + qvel[:, idx.deflection_dof]
-        effort_all = sensordata[:, idx.effort_sensor]
+        effort_all = sensordata[:, idx.effort_sensor]  # the motor's torque (from its current)
+        reported = self.link_torque(qpos, qvel) if self.torque_sensors else effort_all[at_tick]
         acc_mean, piezo = self.sensors.process(
             sensordata[:, idx.acc_sensor], self.tick_steps, self.rng
         )
-        pos, vel, effort, acc = self.sensors.add_noise(
-            self.rng, true_pos, vel, effort_all[at_tick], acc_mean
-        )
+        pos, vel, effort, acc = self.sensors.add_noise(self.rng, true_pos, vel, reported, acc_mean)
         readings = TickReadings(pos, vel, effort, piezo.vib, acc, piezo.bands, piezo.kurtosis)
         self.faults.alter_readings(self._interval, readings)
         scenario = self._interval.scenario

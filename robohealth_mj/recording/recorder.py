@@ -206,6 +206,7 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
         chunk_s=cfg.session.chunk_s,
         faults=faults,
         pushes=read_pushes(cfg.session.get("pushes") or [], model),
+        torque_sensors=description.torque_sensors,
     )
     sim.arm = arm  # the drawn factors ({} for the nominal arm), for the manifest
     sim.ratings = description.ratings()

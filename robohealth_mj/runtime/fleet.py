@@ -361,6 +361,10 @@ class FleetRuntime:
         reasons: dict[int, str] = {}
         self.ticks += 1
         x = np.asarray(x, np.float32)
+        nodes = x.shape[1] if x.ndim == 3 else 0
+        if self.engine is None and nodes != self.graph.n_nodes and nodes >= 4 and nodes % 2 == 0:
+            # no model: any arm's samples are checked as they come, and said to have no model
+            self.graph = schema.ArmGraph(tuple(f"joint{k + 1}" for k in range(nodes // 2)))
         if x.shape[1:] != (self.graph.n_nodes, schema.N_FEATURES):
             shape = (self.graph.n_nodes, schema.N_FEATURES)
             for k in range(n):

@@ -70,12 +70,13 @@ class TrackingController:
 
     def commands(
         self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Actuator commands and feed-forward torques for reference samples ``[n, J]``."""
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Actuator commands, feed-forward (motor) torques and the drives' output (link-side)
+        torques for reference samples ``[n, J]``."""
         motor, spring = self.inverse_dynamics(q, qd, qdd)
         tau_ff = motor + self.coulomb * np.tanh(qd / self.coulomb_velocity_scale)
         ctrl = (q - self.twist(spring)) + (self.kv * qd + tau_ff) / self.kp
-        return ctrl, tau_ff
+        return ctrl, tau_ff, spring
 
     def twist(self, spring: np.ndarray) -> np.ndarray:
         """Drive deflection (link minus motor angle) that produces the required drive torque.

@@ -53,3 +53,22 @@ def test_render_cli_writes_frames_gif_and_pngs(tmp_path):
     assert len(list((tmp_path / "png").glob("frame_*.png"))) == 5
     # the overlay band at the top is drawn (dark, with text pixels)
     assert frames[0][:20].mean() < frames[0][40:].mean()
+
+
+def test_a_seven_joint_arm_renders_with_its_own_joints_tinted(tmp_path):
+    """``render arm=fr3``: the FR3 simulated, its fault named by its joint; its seven housings
+    are the ones a diagnosis tints."""
+    from robohealth_mj.deploy.render import JointTint
+    from robohealth_mj.sim.model import build_model
+
+    tint = JointTint(build_model("fr3"))
+    assert len(set(tint.geoms)) == 7
+    tint.apply([0.0] * 6 + [1.0])  # the tool joint red, the others as they were
+    assert tint.model.geom_rgba[tint.geoms[-1]][0] > 0.9 > tint.model.geom_rgba[tint.geoms[0]][0]
+    cfg = compose_config(
+        "render",
+        ["arm=fr3", "joint=fr3_joint4", "duration_s=0.5", "onset_s=0.2", "fps=4", "width=96",
+         "height=72", "out=null"],
+    )  # fmt: skip
+    frames = render_episode(cfg)
+    assert len(frames) == 2 and all(f.std() > 10 for f in frames)

@@ -165,9 +165,9 @@ def test_a_recorded_line_carries_what_each_channel_name_says(monkeypatch):
         return state, sensordata
 
     def controls(visit, step_times):
-        ctrl, ref_velocity, torque = real_controls(visit, step_times)
+        ctrl, ref_velocity, torque, link = real_controls(visit, step_times)
         captured["torque"].append(torque)
-        return ctrl, ref_velocity, torque
+        return ctrl, ref_velocity, torque, link
 
     monkeypatch.setattr(rollout_module, "rollout", rollout)
     monkeypatch.setattr(sim, "_controls", controls)

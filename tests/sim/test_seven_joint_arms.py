@@ -118,3 +118,23 @@ def test_record_arm_records_the_arms_seven_joint_graph(name, record_cfg, tmp_pat
     assert len(samples) == 60 and all(s.graph.joints == arm.joint_keys for s in samples)
     assert result.manifest["faults"]["schedule"]["scenarios_per_pass"] == 7 * 6 * 3
     assert max(result.manifest["stats"]["tracking_rms_rad"].values()) < 2e-3
+
+
+def test_an_arm_with_joint_torque_sensors_reports_the_link_side_torque(record_cfg):
+    """The FR3's controller reports its joints' torque sensors (the drive's output on the link)
+    and its model of that torque: the healthy residual is the sensor's noise, while the same arm
+    read from its motors' currents carries the friction its model only approximates."""
+    from robohealth_mj.recording.recorder import build_simulator
+
+    residual = {}
+    for sensed in (True, False):
+        sim = build_simulator(record_cfg("arm=fr3", "faults=none"))
+        assert sim.torque_sensors  # the description says so
+        sim.torque_sensors = sensed
+        chunks = list(sim.run(100))
+        r = np.concatenate([c.effort_residual for c in chunks])
+        residual[sensed] = float(np.sqrt(np.mean(r**2)))
+        if sensed:  # what the sensor reads is what the drive's compliance carries
+            last = chunks[-1]
+            assert np.abs(last.effort - last.effort_residual).max() > 0.5  # a real torque
+    assert residual[True] < 0.1 and residual[True] < 0.5 * residual[False], residual

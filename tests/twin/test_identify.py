@@ -61,7 +61,7 @@ def _simulated_log(path: Path, seconds: float, phase: float) -> Path:
     qdd = -amp * w**2 * (np.sin(arg) + 1.587 * np.sin(2.3 * arg))
     controller = TrackingController(model)
     controller.set_payload(0.0)
-    ctrl, _ = controller.commands(q, qd, qdd)
+    ctrl, *_ = controller.commands(q, qd, qdd)
     motor, _ = controller.inverse_dynamics(q, qd, qdd)
     moment = motor - np.asarray(TRUE["damping"]) * qd  # the controller's model: no friction
     idx.set_link_pose(data, q[0])
