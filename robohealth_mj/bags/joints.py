@@ -1,5 +1,5 @@
-"""Which joint is which in a JointState message: the names an arm's driver gives its six joints
-(``conf/joint_names.yaml``: a preset, or six names, with the driver's ``tf_prefix``), found by
+"""Which joint is which in a JointState message: the names an arm's driver gives its joints
+(``conf/joint_names.yaml``: a preset, or the names, with the driver's ``tf_prefix``), found by
 name in whatever order the message lists them."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from omegaconf import DictConfig, ListConfig, OmegaConf
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.common.resources import conf_dir
-from robohealth_mj.schema import JOINT_NAMES, N_JOINTS
+from robohealth_mj.schema import JOINT_NAMES
 
 
 @cache
@@ -21,19 +21,19 @@ def _presets() -> DictConfig:
 
 
 def joint_names(names: str | Sequence[str] = "schema", prefix: str = "") -> tuple[str, ...]:
-    """The six names, base to tool, of a preset in ``conf/joint_names.yaml`` or of a list,
-    each with ``prefix`` before it; a bad value is one line naming ``ros2.joint_names``."""
+    """The names, base to tool, of a preset in ``conf/joint_names.yaml`` or of a list, each
+    with ``prefix`` before it; a bad value is one line naming ``ros2.joint_names``."""
     if isinstance(names, str):
         presets = _presets()
         if names not in presets:
             raise InputError(
                 f"ros2.joint_names: unknown preset {names!r} (presets: {', '.join(presets)}; "
-                "or a list of six names, base to tool)"
+                "or a list of the arm's joint names, base to tool)"
             )
         names = presets[names]
     names = list(names) if isinstance(names, ListConfig | list | tuple) else names
-    if len(names) != N_JOINTS or len(set(names)) != N_JOINTS:
-        raise InputError(f"ros2.joint_names: need six distinct names, base to tool, got {names}")
+    if len(names) < 2 or len(set(names)) != len(names):
+        raise InputError(f"ros2.joint_names: need distinct names, base to tool, got {names}")
     return tuple(f"{prefix}{n}" for n in names)
 
 

@@ -37,7 +37,6 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.jsonl import node_features
 from robohealth_mj.ros2.assembly import Assembled, header_stamp_ns
 from robohealth_mj.schema import (
-    N_JOINTS,
     SENSOR_FEATURES,
     STATE_CHANNELS,
     STATE_FEATURES,
@@ -100,7 +99,8 @@ class DriverAssembler:
         max_age_s: float = 0.1,
     ) -> None:
         """``joint_states`` and ``controller_state``: the arm's topic names; ``joints``: the
-        names its driver gives the six joints, base to tool."""
+        names its driver gives its joints, base to tool (any ros2_control arm: a UR's six, an
+        FR3's seven)."""
         config = config or DriverConfig()
         self.arm, self.joint_states, self.controller_state = arm, joint_states, controller_state
         self.joints, self.tracking = tuple(joints), config.tracking
@@ -108,13 +108,16 @@ class DriverAssembler:
         self.timeout_ns, self.max_age_ns = round(config.timeout_s * 1e9), round(max_age_s * 1e9)
         scale = config.effort_scale
         self.scale = None if scale is None else np.asarray(scale, np.float64)
-        if self.scale is not None and self.scale.shape != (N_JOINTS,):
-            raise InputError(f"ros2.effort_scale: six numbers (N*m per A), got {list(scale)}")
+        if self.scale is not None and self.scale.shape != (len(self.joints),):
+            raise InputError(
+                f"ros2.effort_scale: {len(self.joints)} numbers (N*m per A), one per joint, got "
+                f"{list(scale)}"
+            )
         self.origin: int | None = None  # the tick grid's first instant
         self.next_tick: int | None = None
         self.last_state: tuple[int, Any] | None = None  # the newest joint_states (stamp, msg)
         self.pending: deque[tuple[int, np.ndarray]] = deque()  # ticks waiting for the controller
-        self.errors: deque[tuple[int, np.ndarray]] = deque(maxlen=256)  # (stamp, pos_error [6])
+        self.errors: deque[tuple[int, np.ndarray]] = deque(maxlen=256)  # (stamp, pos_error [J])
         self.last_error: tuple[int, Any] | None = None
         self.silent = False  # the controller is reported silent until its state returns
 
@@ -184,7 +187,7 @@ class DriverAssembler:
         pos, vel, effort = self._columns(msg, msg.name, msg, ("position", "velocity", "effort"))
         if self.scale is not None:
             effort = effort * self.scale
-        state = np.zeros((N_JOINTS, len(STATE_FEATURES)))
+        state = np.zeros((len(self.joints), len(STATE_FEATURES)))
         state[:, _POS], state[:, _VEL], state[:, _EFFORT] = pos, vel, effort
         if self.origin is None:
             self.origin = stamp
@@ -232,7 +235,8 @@ class DriverAssembler:
                 )
 
     def _sample(self, stamp: int, state: np.ndarray) -> GraphSample:
-        x = node_features(state, np.zeros((N_JOINTS, len(SENSOR_FEATURES)))).astype(np.float32)
+        no_sensors = np.zeros((len(self.joints), len(SENSOR_FEATURES)))
+        x = node_features(state, no_sensors).astype(np.float32)
         index = round((stamp - self.origin) / self.period_ns)
         return GraphSample(self.arm, index, stamp / 1e9, x, FaultLabel(),
                            dict(UNLABELLED_SEGMENT), stamp)  # fmt: skip
@@ -248,7 +252,7 @@ class DriverMessages:
         from robohealth_mj.ros2.idl import CONTROLLER_STATES, JointState, JointTrajectoryPoint
 
         self.config, self.joints = config, tuple(joints)
-        self.order = sorted(range(N_JOINTS), key=lambda k: self.joints[k])
+        self.order = sorted(range(len(self.joints)), key=lambda k: self.joints[k])
         self.names = [self.joints[k] for k in self.order]
         self.State, self.Point = CONTROLLER_STATES[config.layout], JointTrajectoryPoint
         self.JointState = JointState
@@ -257,7 +261,7 @@ class DriverMessages:
         """``[joint_states, controller_state]`` of one sample, stamped with its time."""
         from robohealth_mj.ros2.idl import Header, Time
 
-        state = sample.x[:N_JOINTS, STATE_CHANNELS].astype(np.float64)[self.order]
+        state = sample.x[: len(self.joints), STATE_CHANNELS].astype(np.float64)[self.order]
 
         def column(k: int) -> list[float]:
             return state[:, k].tolist()

@@ -31,15 +31,22 @@ def bus_config(cfg: DictConfig) -> Any:
     )
 
 
-def layout_options(cfg: DictConfig, tracking: bool = True) -> dict[str, Any]:
+def layout_options(
+    cfg: DictConfig, tracking: bool = True, arm: str | None = None
+) -> dict[str, Any]:
     """The arm-side settings of ``conf/ros2/default.yaml`` as keyword arguments of ``MonitorNode``
     and ``ArmPublisher``: layout, namespace, joint names and, for ``ur_driver``, the driver's side
-    (``tracking``: the model reads ``pos_error``, so the controller state is awaited)."""
+    (``tracking``: the model reads ``pos_error``, so the controller state is awaited). ``arm``:
+    the arm the model reads, whose driver's joint names ``joint_names=auto`` takes on the
+    ``ur_driver`` layout (any ros2_control driver's: a UR's, an FR3's ...)."""
+    from robohealth_mj.arms.description import load_arm
     from robohealth_mj.ros2.driver import DriverConfig
 
     layout = str(cfg.layout)
     names = cfg.get("joint_names", "auto")
-    if names == "auto":
+    if names == "auto" and layout == "ur_driver" and arm is not None:
+        names = list(load_arm(arm).joint_names)
+    elif names == "auto":
         names = "ur_driver" if layout == "ur_driver" else "schema"
     scale = cfg.get("effort_scale")
     driver = DriverConfig(
@@ -53,6 +60,12 @@ def layout_options(cfg: DictConfig, tracking: bool = True) -> dict[str, Any]:
     return {"layout": layout, "namespace": str(cfg.get("namespace", "/{arm}")),
             "joint_names": names, "tf_prefix": str(cfg.get("tf_prefix") or ""),
             "driver": driver}  # fmt: skip
+
+
+def model_arm(runtime: Any) -> str | None:
+    """The arm the runtime's model reads (None without a model)."""
+    fleet = getattr(runtime, "fleet", runtime)
+    return fleet.arm if getattr(fleet, "engine", None) is not None else None
 
 
 @contextmanager
@@ -100,7 +113,7 @@ def run_monitor(
                        health_diagnosis_hz=float(cfg.get("health_diagnosis_hz", 20.0)),
                        tick_hz=float(cfg.get("tick_hz", 20.0)),
                        diagnose_wait_s=float(cfg.get("diagnose_wait_s", 0.02)),
-                       **layout_options(cfg, tracking))  # fmt: skip
+                       **layout_options(cfg, tracking, model_arm(runtime)))  # fmt: skip
     started = time.monotonic()
     last_report = started
     print(f"ros2 monitor: {len(arms)} arms on domain {cfg.domain_id} ({', '.join(arms[:5])}"

@@ -53,12 +53,12 @@ MSG = {
 }  # fmt: skip
 
 
-def _samples(n: int, seed: int = 0) -> list[GraphSample]:
+def _samples(n: int, seed: int = 0, joints: int = N_JOINTS) -> list[GraphSample]:
     """``n`` ticks of a made-up arm at 20 Hz: smooth joint channels, no sensor package."""
     rng = np.random.default_rng(seed)
-    state = np.cumsum(rng.normal(0, 0.01, (n, N_JOINTS, 5)), axis=0)
+    state = np.cumsum(rng.normal(0, 0.01, (n, joints, 5)), axis=0)
     state[..., 4] = 0.0  # the driver has no torque residual
-    x = node_features(state, np.zeros((n, N_JOINTS, 8))).astype(np.float32)
+    x = node_features(state, np.zeros((n, joints, 8))).astype(np.float32)
     return [GraphSample("arm", k, 10.0 + k * 0.05, x[k], FaultLabel(), {}) for k in range(n)]
 
 
@@ -99,11 +99,13 @@ def test_the_controller_state_s_bytes_equal_rosbags_for_each_distribution(distro
     assert CONTROLLER_STATES[distro].deserialize(reference).error.positions == [0.1, -0.2]
 
 
-def _driver_stream(samples, rate_hz: int = 500, controller_hz: int = 100, gripper: bool = True):
+def _driver_stream(
+    samples, rate_hz: int = 500, controller_hz: int = 100, gripper: bool = True, joints=UR
+):
     """What the driver publishes over ``samples``' span: ``/joint_states`` at ``rate_hz`` with
     the names alphabetical (and a gripper joint), the controller state at ``controller_hz``,
     each holding the last sample's values (the controller's state changes between ticks)."""
-    messages = DriverMessages(UR, DriverConfig())
+    messages = DriverMessages(joints, DriverConfig())
     step = 10**9 // rate_hz
     start = round(samples[0].t * 1e9)
     out = []
@@ -151,6 +153,30 @@ def test_driver_topics_at_500_hz_become_the_model_s_ticks_with_the_tracking_erro
     slow = DriverAssembler("left", "/js", "/cs", UR, DriverConfig(tracking=True))
     got, problems, _ = _run(slow, _driver_stream(samples, controller_hz=4))
     assert problems == [] and [s.sample_index for s in got] == [0, 1, 2, 5, 6, 7, 10]  # 11 waits
+
+
+def test_a_seven_joint_ros2_control_arm_is_assembled_by_its_drivers_names():
+    """franka_ros2's FR3 (any ros2_control driver): seven joints found by the preset's names,
+    the samples on the arm's seven-joint graph; ``joint_names=auto`` takes the model's arm's
+    driver names on the ur_driver layout."""
+    from omegaconf import OmegaConf
+
+    from robohealth_mj.bags.joints import joint_names
+    from robohealth_mj.ros2.live import layout_options
+
+    fr3 = joint_names("franka_ros2")
+    assert fr3 == tuple(f"fr3_joint{k}" for k in range(1, 8))
+    samples = _samples(6, joints=7)
+    assembler = DriverAssembler("fr3", "/js", "/cs", fr3, DriverConfig(tracking=True))
+    got, problems, _ = _run(assembler, _driver_stream(samples, joints=fr3))
+    assert problems == [] and len(got) == 6 and got[0].x.shape == (14, 15)
+    for a, b in zip(got, samples, strict=True):
+        np.testing.assert_allclose(a.x, b.x, atol=1e-6)
+    cfg = OmegaConf.create({"layout": "ur_driver", "joint_names": "auto"})
+    assert layout_options(cfg, arm="fr3")["joint_names"] == list(fr3)
+    assert layout_options(cfg, arm="ur10e")["joint_names"] == list(joint_names("ur_driver"))
+    with pytest.raises(ValueError, match=r"ros2\.effort_scale: 7 numbers"):
+        DriverAssembler("fr3", "/js", "/cs", fr3, DriverConfig(effort_scale=(1.0,) * 6))
 
 
 def test_without_the_controller_a_tracking_model_is_told_once_and_a_reduced_one_goes_on():
@@ -309,7 +335,7 @@ def test_effort_scale_turns_the_driver_s_current_into_torque():
     assert DriverConfig(distro="kilted").layout == DriverConfig(distro="rolling").layout == "jazzy"
     with pytest.raises(ValueError, match=r"ros2\.distro must be one of \['humble', 'jazzy'"):
         DriverConfig(distro="iron")  # end of life, and not a UR driver's
-    with pytest.raises(ValueError, match=r"ros2\.effort_scale: six numbers"):
+    with pytest.raises(ValueError, match=r"ros2\.effort_scale: 6 numbers"):
         DriverAssembler("left", "/js", "/cs", UR, dataclasses.replace(config, effort_scale=(1.0,)))
 
 
