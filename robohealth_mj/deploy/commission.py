@@ -147,9 +147,14 @@ def commission(
     reference = reference or ckpt["config"].get("data", {}).get("train")
     if not reference:
         raise InputError(f"{ckpt_path}: no training data named in it: pass reference=DATA")
-    ref = _healthy(ckpt, reference, "reference")
+    # a model read on another arm (learn/other_arm.py): the reference is its source's to read
+    source = (ckpt.get("read_as") or {}).get("checkpoint")
+    ref_ckpt = load_checkpoint(source) if source else ckpt
+    ref = _healthy(ref_ckpt, reference, "reference")
     ref_x = ref.x[~ref.active]
     w_ref, w_arm = baseline.fit(ref_x), baseline.fit(arm.x)
+    if source:  # each joint against its UR counterpart's baseline
+        w_ref = w_ref[[schema.JOINT_NAMES.index(c) for c in ckpt["read_as"]["counterparts"]]]
     delta = (w_arm - w_ref).astype(np.float32)
     trained = graph_from_checkpoint(ckpt)
     reads = reads_residuals(trained)
@@ -205,12 +210,14 @@ def commission(
     offset, record["operating_point"] = match_operating_point(
         model,
         int(ckpt["window"]),
-        Reading(ref, trained, ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()),
+        Reading(ref, graph_from_checkpoint(ref_ckpt), ref_ckpt["norm_mean"].numpy(),
+                ref_ckpt["norm_std"].numpy()),
         list((ckpt.get("split_runs") or {}).get("val", [])),
         Reading(arm, graph, mean, std),
         operating_point,
         healthy_rate,
-    )
+        model_from_checkpoint(ref_ckpt) if source else None,
+    )  # fmt: skip
     save_checkpoint(
         out_dir / CHECKPOINT,
         model,
@@ -231,6 +238,7 @@ def commission(
             "transfer": ckpt.get("transfer"),
             "commissioning": record,
             "class_offset": offset.tolist(),
+            **({"read_as": ckpt["read_as"]} if source else {}),
         },
     )
     record["checkpoint"] = str(out_dir / CHECKPOINT)

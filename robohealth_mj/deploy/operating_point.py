@@ -142,15 +142,19 @@ def match_operating_point(
     arm: Reading,
     recipe: str = "per_class",
     healthy_rate: float | None = None,
+    validation_model: torch.nn.Module | None = None,
 ) -> tuple[np.ndarray, dict[str, Any]]:
     """The class offset ``[C]`` that has ``arm``'s healthy windows called healthy (``recipe``
     ``healthy``; ``per_class``: called each fault class) at the rate the model calls its
     validation session's (``validation_runs`` of ``validation``, read as in training) healthy
     windows, or at ``healthy_rate`` where that is stricter. Sets it on ``model``; returns it
-    with a record."""
+    with a record. ``validation_model``: the model that reads the validation session where it
+    is another arm's graph (a model read on another arm: its source, whose weights it shares)."""
     check_recipe(recipe, healthy_rate)
     model.class_offset.zero_()
-    target = healthy_logits(model, validation, window, validation_runs)
+    reader = model if validation_model is None else validation_model
+    reader.class_offset.zero_()
+    target = healthy_logits(reader, validation, window, validation_runs)
     logits = healthy_logits(model, arm, window)
     offset = np.zeros(len(model.class_offset), np.float32)
     record: dict[str, Any] = {"validation_windows": len(target), "arm_windows": len(logits),
@@ -164,7 +168,7 @@ def match_operating_point(
     else:
         offset = healthy_offset(target, logits)
     if healthy_rate is not None:  # what the quieter operating point costs, on validation
-        faulted = healthy_logits(model, validation, window, validation_runs, faulted=True)
+        faulted = healthy_logits(reader, validation, window, validation_runs, faulted=True)
         record["healthy_rate_asked"] = healthy_rate
         record["validation_fault_recall_before"] = float((faulted.argmax(1) != 0).mean())
         record["validation_fault_recall_after"] = float(((faulted + offset).argmax(1) != 0).mean())

@@ -28,14 +28,16 @@ _NODE_SQUARE = ("adjacency.residual.logits",)  # [N, N]: a learned edge residual
 _COUPLING = ("anomaly.coupling_logits",)  # [J, M]: joints x sensor packages (structural graph)
 
 
-def read_as(ckpt: dict[str, Any], arm: str) -> dict[str, Any]:
+def read_as(ckpt: dict[str, Any], arm: str, source: str | None = None) -> dict[str, Any]:
     """``ckpt`` (a model of the UR's six joints, structural graph) as a model of ``arm``'s
-    joints, each read as its UR counterpart; a new checkpoint dict (checksum recomputed)."""
-    source = checkpoint_arm(ckpt)
-    if source != schema.UR_GRAPH:
+    joints, each read as its UR counterpart; a new checkpoint dict (checksum recomputed).
+    ``source``: the file ``ckpt`` was read from, which commissioning reads its training
+    arms' data with."""
+    trained = checkpoint_arm(ckpt)
+    if trained != schema.UR_GRAPH:
         raise InputError(
             f"reading another joint count maps each joint to its UR counterpart: a model of the "
-            f"UR's six joints only, not of {list(source.joints)}"
+            f"UR's six joints only, not of {list(trained.joints)}"
         )
     graph = dict(ckpt["graph"])
     if graph.get("coupling") is not None:
@@ -89,7 +91,8 @@ def read_as(ckpt: dict[str, Any], arm: str) -> dict[str, Any]:
         "norm_std": torch.from_numpy(take(ckpt["norm_std"].numpy(), 0)),
         "arms": [arm],  # the arm it now reads (its readings relative to that arm's ratings)
         "read_as": {"arm": arm, "trained_on": list(ckpt.get("arms") or []),
-                    "counterparts": list(description.ur_counterparts())},
+                    "counterparts": list(description.ur_counterparts()),
+                    "checkpoint": None if source is None else str(source)},
     }  # fmt: skip
     out["sha256"] = checkpoint_digest(out)
     return out

@@ -14,24 +14,27 @@ from functools import lru_cache
 import numpy as np
 
 from robohealth_mj import schema
-from robohealth_mj.common.config import compose_config
+from robohealth_mj.common.config import arm_override, compose_config
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.recording.recorder import build_simulator, chunk_features
-from robohealth_mj.schema import JOINT_NAMES, N_JOINTS
 
 SIGNALS = schema.FEATURE_NAMES[schema.STATE_CHANNELS.start :]
 SENSOR_SIGNALS = schema.FEATURE_NAMES[schema.SENSOR_CHANNELS]
 
 
 def _readings(overrides: Sequence[str], seconds: float) -> dict[str, np.ndarray]:
-    """Node features ``x [T, 12, F]`` of a simulated run, plus the per-joint views the older
-    callers use: ``sensor [T, 6, S]`` (sensor nodes) and ``effort [T, 6]``."""
+    """Node features ``x [T, 2J, F]`` of a simulated run (any arm: ``arm=`` among the
+    overrides), plus the per-joint views the older callers use: ``sensor [T, J, S]`` (sensor
+    nodes) and ``effort [T, J]``, and the arm's ``joints``."""
     cfg = compose_config("record", ["session.progress=false", *overrides])
     sim = build_simulator(cfg)
     x = np.concatenate([chunk_features(c) for c in sim.run(round(seconds / sim.tick_s))])
+    j = sim.graph.n_joints
     return {
         "x": x,
-        "sensor": x[:, N_JOINTS:, schema.SENSOR_CHANNELS],
-        "effort": x[:, :N_JOINTS, schema.feature_index("effort")],
+        "sensor": x[:, j:, schema.SENSOR_CHANNELS],
+        "effort": x[:, :j, schema.feature_index("effort")],
+        "joints": sim.graph.joints,
     }
 
 
@@ -42,23 +45,23 @@ def standardised_effect(healthy: np.ndarray, faulted: np.ndarray) -> np.ndarray:
 
 
 def effect_by_sensor(healthy: np.ndarray, faulted: np.ndarray) -> np.ndarray:
-    """Standardised effect per sensor ``[6]``, mean over its channels ``[T, 6, S]``."""
+    """Standardised effect per sensor ``[J]``, mean over its channels ``[T, J, S]``."""
     return standardised_effect(healthy, faulted).mean(axis=-1)
 
 
 def by_hops(effect: np.ndarray, joint: int) -> dict[int, float]:
-    hops = np.abs(np.arange(len(JOINT_NAMES)) - joint)
+    hops = np.abs(np.arange(len(effect)) - joint)
     return {int(h): float(effect[hops == h].mean()) for h in sorted(set(hops.tolist()))}
 
 
 def channel_effects(healthy_x: np.ndarray, faulted_x: np.ndarray, joint: int) -> dict[str, float]:
     """Effect on every signal channel of the faulted joint's own nodes: joint-state channels on
     the joint node, sensor channels on its sensor node."""
-    effect = standardised_effect(healthy_x, faulted_x)  # [12, F]
+    effect = standardised_effect(healthy_x, faulted_x)  # [2J, F]
     out = {}
     for name in SIGNALS:
         c = schema.feature_index(name)
-        node = N_JOINTS + joint if name in SENSOR_SIGNALS else joint
+        node = len(effect) // 2 + joint if name in SENSOR_SIGNALS else joint
         out[name] = float(effect[node, c])
     return out
 
@@ -79,6 +82,8 @@ def measure(
 ) -> dict:
     """One row: per-channel effect at the faulted joint, sensor effect by hops, effort shift."""
     healthy = _healthy(seed, seconds, tuple(extra))
+    if joint not in healthy["joints"]:
+        raise InputError(f"--joints: {joint!r} is not a joint of this arm ({healthy['joints']})")
     faulted = _readings(
         [
             f"seed={seed}",
@@ -91,7 +96,7 @@ def measure(
         ],
         seconds,
     )
-    j = JOINT_NAMES.index(joint)
+    j = healthy["joints"].index(joint)
     sensors = effect_by_sensor(healthy["sensor"], faulted["sensor"])
     effort_shift = float(
         np.abs(faulted["effort"][:, j]).mean() - np.abs(healthy["effort"][:, j]).mean()
@@ -117,13 +122,16 @@ def sweep(
     models: Iterable[str],
     seconds: float,
     seed: int,
+    arm: str | None = None,
 ) -> Iterable[dict]:
-    """Rows for every fault x joint x severity x fault model, in that nesting order."""
+    """Rows for every fault x joint x severity x fault model, in that nesting order, on ``arm``
+    (a shipped arm's name or a URDF; default the UR5e)."""
+    extra = tuple(arm_override(f"arm={arm}")) if arm else ()
     for fault_class in classes:
         for joint in joints:
             for severity in severities:
                 for model in models:
-                    yield measure(fault_class, joint, severity, model, seconds, seed)
+                    yield measure(fault_class, joint, severity, model, seconds, seed, extra)
 
 
 # Columns of the printed table: the faulted joint's channels, grouped as the README shows them.

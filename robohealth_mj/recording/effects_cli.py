@@ -6,6 +6,7 @@ the mean effect over the sensor channels of the neighbouring joints' sensors.
 
     python -m robohealth_mj.effects [--joints shoulder_pan elbow wrist_3]
         [--severities 0.3 0.6 0.9] [--seconds 30] [--models physics] [--json rows.json]
+    python -m robohealth_mj.effects --arm fr3 --joints fr3_joint2 fr3_joint4 fr3_joint7
 """
 
 from __future__ import annotations
@@ -13,11 +14,22 @@ from __future__ import annotations
 import argparse
 
 from robohealth_mj.common.errors import one_line_errors
-from robohealth_mj.schema import JOINT_NAMES
+
+DEFAULT_JOINTS = ("shoulder_pan", "elbow", "wrist_3")
 
 with one_line_errors("effects"):  # a missing extra is one line, not a traceback
     from robohealth_mj.faults.catalogue import FAULT_MODELS, MODES
     from robohealth_mj.recording.effect_sizes import COLUMNS, sweep, table_row
+
+
+def default_joints(arm: str | None) -> list[str]:
+    """The base, a middle and the tool joint of ``arm`` (the UR's shoulder pan, elbow, wrist 3)."""
+    if arm is None:
+        return list(DEFAULT_JOINTS)
+    from robohealth_mj.arms.description import load_arm
+
+    keys = load_arm(arm).joint_keys
+    return [keys[0], keys[len(keys) // 2], keys[-1]]
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -27,8 +39,13 @@ def main(argv: list[str] | None = None) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "--joints", nargs="+", default=["shoulder_pan", "elbow", "wrist_3"], choices=JOINT_NAMES
+        "--arm", default=None, help="the arm (ur5e, fr3 ..., your.urdf); default the UR5e"
     )
+    parser.add_argument(
+        "--joints", nargs="+", default=None,
+        help=f"the arm's joints to fault (default: {' '.join(DEFAULT_JOINTS)} on a UR; the "
+        "base, middle and tool joints on another arm)",
+    )  # fmt: skip
     parser.add_argument("--severities", nargs="+", type=float, default=[0.3, 0.6, 0.9])
     parser.add_argument("--seconds", type=float, default=30.0)
     parser.add_argument("--seed", type=int, default=0)
@@ -39,6 +56,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     if any(not 0.0 <= s <= 1.0 for s in args.severities):
         parser.error("--severities must lie in [0, 1]")
+    joints = args.joints or default_joints(args.arm)
     names = [*COLUMNS, "1-hop"]
     if args.markdown:
         print("| fault | joint | sev. | model | " + " | ".join(names) + " |")
@@ -49,7 +67,7 @@ def main(argv: list[str] | None = None) -> None:
         )
     rows = []
     for row in sweep(
-        args.classes, args.joints, args.severities, args.models, args.seconds, args.seed
+        args.classes, joints, args.severities, args.models, args.seconds, args.seed, args.arm
     ):
         rows.append(row)
         values = table_row(row)

@@ -38,9 +38,9 @@ from robohealth_mj.sim.twin_file import read_twin_noise
 GRAPHS_FILE = "graphs.jsonl"
 MANIFEST_FILE = "manifest.json"
 _IDENTITY_EXCLUDE = ("out_dir", "progress", "run_id")
-# sim settings added after recordings were made: left out of the id while unset, so that adding
+# settings added after recordings were made: left out of the id while unset, so that adding
 # them kept every earlier recording's id
-_OPTIONAL_SIM = ("friction_solref", "friction_solimp")
+_OPTIONAL = (("sim", "friction_solref"), ("sim", "friction_solimp"), ("sensors", "joint_torque"))
 
 
 def session_config(cfg: DictConfig) -> dict[str, Any]:
@@ -52,9 +52,9 @@ def default_run_id(cfg: DictConfig) -> str:
     """A run id fixed by what was simulated (same config, same id, same bytes)."""
     data = session_config(cfg)
     data["session"] = {k: v for k, v in data["session"].items() if k not in _IDENTITY_EXCLUDE}
-    for key in _OPTIONAL_SIM:
-        if data.get("sim", {}).get(key, 0) is None:
-            del data["sim"][key]
+    for section, key in _OPTIONAL:
+        if data.get(section, {}).get(key, 0) is None:
+            del data[section][key]
     if data["session"].get("pushes") == []:  # added later too: out of the id while empty
         del data["session"]["pushes"]
     digest = hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:10]
@@ -206,7 +206,9 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
         chunk_s=cfg.session.chunk_s,
         faults=faults,
         pushes=read_pushes(cfg.session.get("pushes") or [], model),
-        torque_sensors=description.torque_sensors,
+        torque_sensors=(
+            description.torque_sensors if sensors.joint_torque is None else sensors.joint_torque
+        ),
     )
     sim.arm = arm  # the drawn factors ({} for the nominal arm), for the manifest
     sim.ratings = description.ratings()

@@ -49,7 +49,6 @@ _POS = schema.feature_index("pos")
 _VEL = schema.feature_index("vel")
 _EFFORT = schema.feature_index("effort")
 _RESIDUAL = schema.feature_index("effort_residual")
-J = schema.N_JOINTS
 REPLACE_GROWTH = 1.5  # a contact is placed again when its torques have grown this much
 
 
@@ -109,8 +108,9 @@ def contact_metadata(meta: dict, source: str) -> tuple[np.ndarray, Placing | Non
     key = "contact_threshold_nm"
     try:
         threshold = np.asarray(json.loads(meta[key]), np.float64)
-        if threshold.shape != (J,) or not (threshold > 0).all():
-            raise ValueError(f"expected {J} positive values, got {threshold.tolist()}")
+        joints = len(meta.get("joints") or schema.JOINT_NAMES)  # one per joint of the arm
+        if threshold.shape != (joints,) or not (threshold > 0).all():
+            raise ValueError(f"expected {joints} positive values, got {threshold.tolist()}")
         key = "contact_placing"
         placing = Placing.from_dict(json.loads(meta[key])) if meta.get(key) else None
     except (ValueError, KeyError, TypeError) as exc:  # JSON's decode error is a ValueError
@@ -132,7 +132,8 @@ class ContactBank:
     ) -> None:
         self.policy = policy
         self.placing = placing
-        self.threshold = np.asarray(threshold_nm, np.float64).reshape(J)
+        self.threshold = np.asarray(threshold_nm, np.float64).ravel()  # [J], the arm's joints
+        self.joints = J = len(self.threshold)
         self.command_nm = policy.command_share * rated_torque_nm(arm)
         self.ring = np.zeros((capacity, policy.level_ticks, J), np.float32)
         self.skip = np.zeros((capacity, policy.level_ticks), bool)  # tick was over a threshold
@@ -157,14 +158,14 @@ class ContactBank:
         self.placed[slots] = -1
 
     def deviation(self, slots: np.ndarray, x: np.ndarray) -> np.ndarray:
-        """One raw snapshot per slot (distinct) ``x [B, 12, F]`` -> how far each joint's residual
+        """One raw snapshot per slot (distinct) ``x [B, 2J, F]`` -> how far each joint's residual
         is off its level ``[B, J]`` in N·m, NaN where the stream is not watched (moving, or not
         settled)."""
         return np.abs(self.offset(slots, x))
 
     def offset(self, slots: np.ndarray, x: np.ndarray) -> np.ndarray:
         """As :meth:`deviation`, with its sign: each joint's residual minus its level."""
-        p = self.policy
+        p, J = self.policy, self.joints
         vel, residual = x[:, :J, _VEL], x[:, :J, _RESIDUAL]
         model = x[:, :J, _EFFORT] - residual
         fresh = self.quiet[slots] == 0
@@ -204,7 +205,7 @@ class ContactBank:
         run = np.where(hit, self.over[slots] + 1, 0)
         self.over[slots] = run
         contact = run >= self.policy.confirm
-        distal = J - 1 - np.argmax(over[:, ::-1], axis=1)
+        distal = self.joints - 1 - np.argmax(over[:, ::-1], axis=1)
         named = np.where(contact, distal, -1)
         if self.placing is not None:
             named = self._place(slots, x, off, contact, named)
@@ -226,8 +227,9 @@ class ContactBank:
         again = (self.over[slots[on]] == self.policy.confirm) | (
             size >= REPLACE_GROWTH * self.placed_size[slots[on]]
         )
+        joints = self.joints
         for b, grown in zip(on[again], size[again], strict=True):  # a contact's first tick, or
-            where = place(p.surface, x[b, :J, _POS], -off[b], p.noise_nm)  # a growing one
+            where = place(p.surface, x[b, :joints, _POS], -off[b], p.noise_nm)  # a growing one
             self.placed[slots[b]], self.placed_size[slots[b]] = where.joint, grown
         placed = self.placed[slots]
         return np.where(contact & (placed >= 0), placed, distal)
@@ -249,8 +251,9 @@ def quiet_deviations(
     runs: list[np.ndarray], arm: str, policy: ContactPolicy | None = None
 ) -> np.ndarray:
     """Each joint's largest quiet deviation ``[J]`` (N·m) over ``runs``, each a run of raw
-    snapshots ``[T, 12, F]`` in time order; NaN for a joint never watched."""
+    snapshots ``[T, 2J, F]`` in time order; NaN for a joint never watched."""
     policy = policy or ContactPolicy()
+    J = runs[0].shape[1] // 2 if runs else schema.N_JOINTS
     worst = np.full(J, np.nan)
     for run in runs:
         bank = ContactBank(policy, np.full(J, np.inf), arm, 1)

@@ -79,7 +79,12 @@ class SensorPackage:
         sub_bands_hz: tuple[tuple[float, float], ...] = SUB_BANDS_HZ,
         filter_order: int = 4,
         noise: dict | NoiseFloor | None = None,
+        joint_torque: bool | None = None,
     ) -> None:
+        """``joint_torque``: what the controller reports as a joint's torque: True, a torque
+        sensor in the joint (the link side of the drive); False, the motor's current; None, what
+        the arm has (its description: the FR3, iiwa and Gen3 carry torque sensors)."""
+        self.joint_torque = joint_torque
         if len(sub_bands_hz) != len(SUB_BANDS_HZ):
             raise InputError(
                 f"sensors.sub_bands_hz needs {len(SUB_BANDS_HZ)} bands (the schema's), "

@@ -18,6 +18,15 @@ C="$PY studies/arms/campaign.py --arms $ARMS --stages own --steps train --seeds 
 ($C --variants gbdt --override model.severity=false && $C --variants mlp --epochs 10) &
 $C --variants anomaly_residual --epochs 10
 wait
+# The ablation: the FR3 read from its motors' currents (sensors.joint_torque=false) instead of its
+# joint torque sensors, which see the link side of the drive and so not the drive's friction.
+$PY -m robohealth_mj.corpus corpus=arms out_dir=outputs/corpus/arms/fr3_current progress=false \
+  'record_overrides=["arm=fr3","sensors.joint_torque=false"]' '~corpus.healthy_hour' \
+  '~corpus.probe_payload_high'
+D="$PY studies/arms/campaign.py --arms fr3_current --stages own --steps train --seeds 42 --out outputs/campaign_seven"
+($D --variants gbdt --override model.severity=false) &
+$D --variants anomaly_residual --epochs 10
+wait
 $PY studies/arms/summarise.py --out outputs/campaign_seven
 $PY studies/arms/six_to_seven.py
 $PY studies/arms/tracking_and_speed.py

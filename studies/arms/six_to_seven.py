@@ -1,6 +1,7 @@
 """Issue 65's hard case: a model trained on a six-joint arm only (the UR5e's own models of
 ``studies/arms/run_seven.sh``), read on each seven-joint arm, each joint as its UR counterpart
-(``learn/other_arm.py``), beside the arm's own model of the same recipe.
+(``learn/other_arm.py``), before and after commissioning on the arm's ten healthy minutes,
+beside the arm's own model of the same recipe.
 
     python studies/arms/six_to_seven.py [--source ur5e] [--targets fr3,iiwa14,gen3,xarm7]
         [--variants mlp,anomaly_residual] [--seeds 42]
@@ -43,8 +44,8 @@ def main() -> None:
     parser.add_argument("--seeds", default="42")
     args = parser.parse_args()
     targets = args.targets.split(",")
-    print("| arm | variant | own acc. | own loc. | six-joint model read on it: acc. | loc. |\n"
-          "|---|---|---|---|---|---|")  # fmt: skip
+    print("| arm | variant | own acc. | own loc. | UR5e's model read on it: acc. | loc. | "
+          "... commissioned: acc. | loc. |\n|---|---|---|---|---|---|---|---|")  # fmt: skip
     for variant in args.variants.split(","):
         for seed in args.seeds.split(","):
             source = own_run(args.source, variant, seed)
@@ -54,17 +55,29 @@ def main() -> None:
                 run = OUT / "six" / arm / variant / f"seed{seed}"
                 if not (run / "best.ckpt").is_file():
                     run.mkdir(parents=True, exist_ok=True)
-                    adapted = read_as(load_checkpoint(source / "best.ckpt"), arm)
+                    trained = source / "best.ckpt"
+                    adapted = read_as(load_checkpoint(trained), arm, str(trained.resolve()))
                     write_checkpoint(run / "best.ckpt", adapted)
                 if not (run / "eval_heldout.json").is_file():
                     run_step("robohealth_mj.evaluate", f"ckpt={run / 'best.ckpt'}",
                              f"data={CORPUS / arm / 'heldout_seed900'}",
                              f"out={run / 'eval_heldout'}", quiet=True)  # fmt: skip
+                done = run / "commissioned"
+                if not (done / "best.ckpt").is_file():
+                    run_step("robohealth_mj.commission", f"model={run / 'best.ckpt'}",
+                             f"healthy={CORPUS / arm / 'healthy_commissioning_seed940'}",
+                             f"out={done}", quiet=True)  # fmt: skip
+                if not (done / "eval_heldout.json").is_file():
+                    run_step("robohealth_mj.evaluate", f"ckpt={done / 'best.ckpt'}",
+                             f"data={CORPUS / arm / 'heldout_seed900'}",
+                             f"out={done / 'eval_heldout'}", quiet=True)  # fmt: skip
                 read = metrics(run / "eval_heldout.json")
+                after = metrics(done / "eval_heldout.json")
                 mine = own_run(arm, variant, seed)
                 own = (metrics(mine / "eval_heldout.json") if mine else None) or {}
                 cells = [own.get("accuracy"), own.get("localisation_accuracy"),
-                         read["accuracy"], read["localisation_accuracy"]]  # fmt: skip
+                         read["accuracy"], read["localisation_accuracy"],
+                         after["accuracy"], after["localisation_accuracy"]]  # fmt: skip
                 shown = " | ".join("–" if c is None else f"{c:.3f}" for c in cells)
                 print(f"| {arm} | {variant} | {shown} |")
 

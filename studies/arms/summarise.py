@@ -31,7 +31,19 @@ from robohealth_mj.reporting.markdown import heading
 ROOT = Path(__file__).resolve().parents[2]
 OUT = ROOT / "outputs" / "campaign_arms"
 RESULTS = Path(__file__).resolve().parent / "results"
-ARMS = ("ur3e", "ur5e", "ur10e", "ur16e", "ur20", "ur30", "fr3", "iiwa14", "gen3", "xarm7")  # rows
+ARMS = (
+    "ur3e",
+    "ur5e",
+    "ur10e",
+    "ur16e",
+    "ur20",
+    "ur30",
+    "fr3",
+    "fr3_current",
+    "iiwa14",
+    "gen3",
+    "xarm7",
+)  # the rows, where a campaign has them (fr3_current: the FR3 read from its currents)
 TICK_S = 0.05
 
 

@@ -278,3 +278,18 @@ def test_effects_tool_prints_a_row_per_fault_joint_and_severity(capsys, tmp_path
     rows = json.loads(out.read_text())
     assert [r["joint"] for r in rows] == ["elbow", "wrist_3"]
     assert all(r["channels"]["effort_residual"] > 3.0 for r in rows)  # the drive works harder
+
+
+def test_effect_sizes_are_measured_on_a_seven_joint_arm_by_its_joint_names():
+    """``effects --arm fr3``: the FR3's own joints, seven sensors, hops along its chain; its
+    torque sensors read the link side, so a drive's friction barely moves their residual while
+    the tracking error shows it; a joint the arm lacks is one line."""
+    from robohealth_mj.common.errors import InputError
+    from robohealth_mj.recording.effect_sizes import sweep
+
+    (row,) = sweep(["friction"], ["fr3_joint4"], [0.9], ["physics"], 6.0, 0, arm="fr3")
+    assert row["joint"] == "fr3_joint4" and len(row["effect_by_sensor"]) == 7
+    assert set(row["effect_by_hops"]) == {0, 1, 2, 3}
+    assert row["channels"]["pos_error"] > 5 * row["channels"]["effort_residual"]
+    with pytest.raises(InputError, match="'elbow' is not a joint of this arm"):
+        list(sweep(["jam"], ["elbow"], [0.9], ["physics"], 2.0, 0, arm="fr3"))

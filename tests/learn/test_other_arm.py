@@ -46,3 +46,29 @@ def test_a_ur_arm_reads_as_itself_and_a_harness_model_is_refused(deployed):
         read_as(load_checkpoint(deployed["harness_ckpt"]), "fr3")
     with pytest.raises(InputError, match="a model of the UR's six joints only"):
         read_as(read_as(ckpt, "fr3"), "gen3")
+
+
+def test_a_ur_model_read_on_an_fr3_is_commissioned_on_the_fr3s_healthy_running(
+    deployed, record_cfg, tmp_path
+):
+    """Commissioning a six-joint model read on a seven-joint arm: the arm's residual baseline
+    against each joint's UR counterpart's, the operating point matched to the UR validation
+    session as the source model reads it; the commissioned model is the FR3's and exports."""
+    from robohealth_mj.deploy.commission import commission
+    from robohealth_mj.learn.checkpoint import write_checkpoint
+    from robohealth_mj.recording.recorder import record_session
+    from robohealth_mj.runtime.metadata import read_metadata
+
+    healthy = tmp_path / "fr3_healthy"
+    record_session(record_cfg("arm=fr3", "faults=none", "session.duration_s=40"), healthy)
+    source = str(deployed["structural_ckpt"])
+    write_checkpoint(tmp_path / "read.ckpt", read_as(load_checkpoint(source), "fr3", source))
+    record = commission(tmp_path / "read.ckpt", str(healthy), tmp_path / "done")
+    done = load_checkpoint(tmp_path / "done" / "best.ckpt")
+    assert done["read_as"]["checkpoint"] == source and done["arms"] == ["fr3"]
+    shift = np.asarray(done["graph"]["baseline_shift"])
+    assert shift.shape[0] == 7 and np.abs(shift).sum() > 0  # the FR3's own baseline
+    assert record["operating_point"]["validation_windows"] > 0
+    assert len(done["class_offset"]) == 7  # the seven fault classes' offsets
+    meta = read_metadata(tmp_path / "done" / "model.onnx")
+    assert meta["arm"] == "fr3" and meta["arm_graph"].n_joints == 7

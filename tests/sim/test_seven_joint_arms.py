@@ -123,14 +123,16 @@ def test_record_arm_records_the_arms_seven_joint_graph(name, record_cfg, tmp_pat
 def test_an_arm_with_joint_torque_sensors_reports_the_link_side_torque(record_cfg):
     """The FR3's controller reports its joints' torque sensors (the drive's output on the link)
     and its model of that torque: the healthy residual is the sensor's noise, while the same arm
-    read from its motors' currents carries the friction its model only approximates."""
+    read from its motors' currents (``sensors.joint_torque=false``) carries the friction its
+    model only approximates."""
     from robohealth_mj.recording.recorder import build_simulator
 
     residual = {}
-    for sensed in (True, False):
-        sim = build_simulator(record_cfg("arm=fr3", "faults=none"))
-        assert sim.torque_sensors  # the description says so
-        sim.torque_sensors = sensed
+    for sensed, setting in ((True, "null"), (False, "false")):  # the arm's sensors; its motors
+        sim = build_simulator(
+            record_cfg("arm=fr3", "faults=none", f"sensors.joint_torque={setting}")
+        )
+        assert sim.torque_sensors is sensed
         chunks = list(sim.run(100))
         r = np.concatenate([c.effort_residual for c in chunks])
         residual[sensed] = float(np.sqrt(np.mean(r**2)))
