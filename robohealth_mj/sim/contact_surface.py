@@ -11,7 +11,6 @@ import mujoco
 import numpy as np
 
 from robohealth_mj.arms.contact_place import ArmSurface
-from robohealth_mj.schema import JOINT_NAMES
 from robohealth_mj.sim.dynamics import nominal_model
 
 AROUND, ALONG = 16, 7  # surface points: around each geom, and along its axis
@@ -55,11 +54,12 @@ def geom_in_body(model: mujoco.MjModel, geom: int) -> tuple[np.ndarray, np.ndarr
 
 
 def arm_surface(arm: str) -> ArmSurface:
-    """The chain of ``arm``'s six joints and its links' collision surfaces."""
+    """The chain of ``arm``'s joints and its links' collision surfaces."""
     model, _ = nominal_model(arm)
     offset_pos, offset_rot, anchor, axis = [], [], [], []
     link, point, normal = [], [], []
-    for j, name in enumerate(JOINT_NAMES):
+    joints = [model.actuator(k).name for k in range(model.nu)]  # one servo per joint, in order
+    for j, name in enumerate(joints):
         joint = model.joint(f"{name}_joint")
         body = int(joint.bodyid[0])
         turn = np.empty(9)

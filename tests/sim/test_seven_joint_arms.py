@@ -140,3 +140,20 @@ def test_an_arm_with_joint_torque_sensors_reports_the_link_side_torque(record_cf
             last = chunks[-1]
             assert np.abs(last.effort - last.effort_residual).max() > 0.5  # a real torque
     assert residual[True] < 0.1 and residual[True] < 0.5 * residual[False], residual
+
+
+def test_the_contact_watch_places_a_push_on_a_seven_joint_arms_links():
+    """Commissioning's contact placing reads the arm's own chain: seven joints, every link's
+    surface; a push at a point of the sixth link, pressing along its inward normal, is placed
+    on a link at or beyond it (the joints before cannot tell it from one further out)."""
+    from robohealth_mj.arms.contact_place import place
+    from robohealth_mj.sim.contact_surface import arm_surface
+
+    surface = arm_surface("fr3")
+    assert surface.axis.shape == (7, 3) and set(np.unique(surface.link)) == set(range(7))
+    q = load_arm("fr3").home_pose()
+    lever, normal = surface.lever(q)
+    k = int(np.flatnonzero(surface.link == 5)[0])
+    torque = lever[k] @ (-20.0 * normal[k])  # 20 N pressing on the point
+    where = place(surface, q, torque, np.full(7, 0.05))
+    assert len(where.chi2) == 7 and where.joint >= 5
