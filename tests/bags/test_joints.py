@@ -19,8 +19,11 @@ def test_presets_lists_and_the_driver_s_prefix():
     assert joint_names(list("abcdef"), "x/") == tuple(f"x/{c}" for c in "abcdef")
     with pytest.raises(InputError, match=r"ros2.joint_names: unknown preset 'ur10'"):
         joint_names("ur10")
-    with pytest.raises(InputError, match="six distinct names"):
+    with pytest.raises(InputError, match="need distinct names, base to tool"):
         joint_names(["a", "b", "c", "d", "e", "e"])
+    with pytest.raises(InputError, match="need distinct names, base to tool"):
+        joint_names(["a"])  # an arm of one joint is no chain
+    assert len(joint_names("xarm_ros2")) == 7  # a seven-joint driver's preset
 
 
 def test_joints_are_found_by_name_in_any_order_and_a_missing_one_is_named():
