@@ -25,7 +25,7 @@ TICK_S = 0.05
 
 @dataclass
 class Replay:
-    """``x [T, 12, F]`` of real recordings and each stream's starting offset."""
+    """``x [T, 2J, F]`` of real recordings and each stream's starting offset."""
 
     x: np.ndarray
     offsets: np.ndarray

@@ -1,10 +1,11 @@
 """Exporting a checkpoint to a self-contained ONNX model.
 
-The model takes *raw* schema windows ``x: float32[B, W, 12, F]`` of one arm: that arm's channel
-scale (:mod:`robohealth_mj.data.relative`), the graph transform (the harness mixing, when the
-model was trained under it) and the normalisation are inside the graph, so a deployment feeds
-sensor readings as they arrive. Metadata carries everything the runtime checks: node order,
-feature names, window, label table, schema version, fingerprints, the arm it reads.
+The model takes *raw* windows ``x: float32[B, W, 2J, F]`` of one arm (on its graph: 12 nodes on
+a UR): that arm's channel scale (:mod:`robohealth_mj.data.relative`), the graph transform (the
+harness mixing, when the model was trained under it) and the normalisation are inside the graph,
+so a deployment feeds sensor readings as they arrive. Metadata carries everything the runtime
+checks: node order, feature names, window, label table, schema version, fingerprints, the arm it
+reads and its graph.
 """
 
 from __future__ import annotations
@@ -140,7 +141,7 @@ def incremental_graphs(
     model: nn.Module, pre: nn.Module, run: torch.Tensor, window: int
 ) -> dict[str, str]:
     """The incremental form's two graphs (base64 ONNX, for the metadata) after checking it
-    against the windowed model on every window of ``run`` (``[T, 12, F]`` consecutive)."""
+    against the windowed model on every window of ``run`` (``[T, 2J, F]`` consecutive)."""
     import onnxruntime as ort
 
     from robohealth_mj.runtime.incremental import IncrementalEngine

@@ -41,7 +41,7 @@ def mixed_statistics(
 
 def healthy_sensor_statistics(graph: GraphSpec, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Mean and std ``[M, C]`` of ``graph``'s sensor channels over schema snapshots ``x``
-    ``[T, 12, F]`` (healthy running): the sensor rows of a placement's normalisation."""
+    ``[T, 2J, F]`` (healthy running): the sensor rows of a placement's normalisation."""
     mixed = graph.transform(x)[:, graph.num_joints :, schema.SENSOR_CHANNELS].astype(np.float64)
     std = mixed.std(axis=0)
     std[std < 1e-6] = 1.0
@@ -51,7 +51,7 @@ def healthy_sensor_statistics(graph: GraphSpec, x: np.ndarray) -> tuple[np.ndarr
 class PlacementPool:
     """``size`` placements of the graph's ``M`` sensors, and the packages they mix.
 
-    ``x`` is the recording's schema snapshots ``[T, 12, F]`` after the sensing profile's mask;
+    ``x`` is the recording's snapshots ``[T, 2J, F]`` after the sensing profile's mask;
     ``healthy`` marks the snapshots (training windows, no active fault) whose statistics
     z-score each placement's sensors.
     """

@@ -44,7 +44,7 @@ class TickChunk:
     kurtosis: np.ndarray  # [n, 6] piezo kurtosis over the tick
     true_pos: np.ndarray  # [n, 6] noise-free link angle
     reference: np.ndarray  # [n, 6]
-    saturated_steps: np.ndarray  # [6] physics steps at the torque limit, per joint
+    saturated_steps: np.ndarray  # [J] physics steps at the torque limit, per joint
     contacts: int  # contacts present at the end of the chunk
     fault: FaultLabel  # the ground truth, constant over the chunk
 

@@ -153,7 +153,7 @@ class IncrementalEngine(_Engine):
         self.phase[slots] = np.asarray(slots) % self.block
 
     def push(self, slots: np.ndarray, x: np.ndarray) -> None:
-        """Add one raw snapshot ``x [B, 12, F]`` to each stream in ``slots`` (distinct)."""
+        """Add one raw snapshot ``x [B, 2J, F]`` to each stream in ``slots`` (distinct)."""
         w = self.window
         h = self.head[slots]
         z_prev, z_first = self.z[(h - 1) % w, slots], self.z[(h + 1) % w, slots]
@@ -207,7 +207,7 @@ class WindowedEngine(_Engine):
         self.clock.mark("rings, sums")
 
     def windows(self, slots: np.ndarray) -> np.ndarray:
-        """``[B, W, 12, F]``, oldest first."""
+        """``[B, W, 2J, F]``, oldest first."""
         idx = self.head[slots][:, None] + np.arange(self.window)
         return self.ring[slots[:, None], idx]
 
