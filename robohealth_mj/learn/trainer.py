@@ -121,11 +121,12 @@ def prepare(cfg: DictConfig) -> Prepared:
     if cfg.trainer.get("threads"):
         torch.set_num_threads(int(cfg.trainer.threads))
     device = pick_device(cfg.trainer.device)
+    graph: GraphSpec = instantiate(cfg.graph)  # a bad config value is named before any data
+    sensing = instantiate(cfg.sensing)
     files = expand_paths(cfg.data.train)
     check_transfer(cfg, files)
     rec = load_recordings(files)
-    graph: GraphSpec = instantiate(cfg.graph).for_arm(rec.graph)  # the recordings' arm's
-    graph = graph.with_sensing(instantiate(cfg.sensing))
+    graph = graph.for_arm(rec.graph).with_sensing(sensing)  # the recordings' arm's graph
     rec = graph.relabel(rec)
     rec = label_windows(rec, int(cfg.window), str(cfg.get("labels", "last")))
     x = graph.transform(rec.x)
