@@ -30,3 +30,11 @@ wait
 $PY studies/arms/summarise.py --out outputs/campaign_seven
 $PY studies/arms/six_to_seven.py
 $PY studies/arms/tracking_and_speed.py
+# A mixed fleet: the UR5e's and the FR3's own headline models in one process (results/mixed_fleet.md)
+RUN=structural/full/C0/anomaly_residual/w32/seed42
+for arm in ur5e fr3; do
+  $PY -m robohealth_mj.export ckpt=outputs/campaign_seven/full/own/$arm/$RUN/best.ckpt
+done
+$PY -m robohealth_mj.bench mixed --streams 500 --ticks 100 --rounds 3 \
+  --model outputs/campaign_seven/full/own/{ur5e,fr3}/$RUN/model.onnx \
+  --data outputs/corpus/arms/{ur5e,fr3}/heldout_seed900
