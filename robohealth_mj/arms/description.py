@@ -117,6 +117,11 @@ class ArmDescription:
             for j in range(self.n_joints)
         )
 
+    def ur_counterpart_index(self) -> list[int]:
+        """:meth:`ur_counterparts` as indices into the UR's joints (what per-joint values stated
+        for the UR are taken with)."""
+        return [JOINT_NAMES.index(c) for c in self.ur_counterparts()]
+
     def ratings(self) -> dict[str, Any]:
         """The arm's identity and ratings, as manifests and checkpoints carry them."""
         return {

@@ -33,7 +33,7 @@ def _scale(arm: str) -> np.ndarray:
     j = own.n_joints
     scale = np.ones((2 * j, schema.N_FEATURES), np.float32)
     # each joint against the reference arm's joint of its class (an arm of other joints)
-    k = [ref.joint_keys.index(c) for c in own.ur_counterparts()]
+    k = own.ur_counterpart_index()  # the reference arm is a UR: its joints are the UR's
     torque = (ref.rated_torque[k] / own.rated_torque).astype(np.float32)
     speed = (ref.speed_limit[k] / own.speed_limit).astype(np.float32)
     for names, per_joint in ((TORQUE_CHANNELS, torque), (SPEED_CHANNELS, speed)):

@@ -44,17 +44,18 @@ def read_as(ckpt: dict[str, Any], arm: str, source: str | None = None) -> dict[s
         raise InputError("graph=harness: its placement is the UR arm's; read a structural model")
     description = load_arm(arm)
     target = schema.ArmGraph(description.joint_keys)
-    joints = [schema.JOINT_NAMES.index(c) for c in description.ur_counterparts()]
+    joints = description.ur_counterpart_index()
     n_src = schema.UR_GRAPH.n_joints
     nodes = joints + [n_src + j for j in joints]
     kept = int(graph.get("schema_nodes", schema.N_NODES))  # 6: the joints only (stock)
     rows = nodes[: target.n_joints] if kept == n_src else nodes
     adjacency = target.adjacency()[: len(rows), : len(rows)]
 
-    def take(value, *axes: int):
+    def take(value, *axes: int) -> np.ndarray:
+        """``value`` with its node ``axes`` taken row by row from the counterparts."""
         array = np.asarray(value)
         for axis in axes:
-            array = np.take(array, rows if array.shape[axis] == kept else joints, axis=axis)
+            array = np.take(array, rows, axis=axis)
         return array
 
     state = {}
@@ -75,7 +76,7 @@ def read_as(ckpt: dict[str, Any], arm: str, source: str | None = None) -> dict[s
         "node_names": list(target.nodes[: len(rows)]),
         "adjacency": adjacency.tolist(),
         "num_joints": target.n_joints,
-        "schema_nodes": len(rows) if kept == n_src else target.n_nodes,
+        "schema_nodes": len(rows),
         "channel_mask": None if mask is None else take(mask, 0).tolist(),
         "baseline_shift": None if shift is None else np.asarray(shift)[joints].tolist(),
         "joints": list(target.joints),

@@ -31,7 +31,7 @@ from robohealth_mj.data.jsonl import format_line, node_features
 from robohealth_mj.data.windows import recorded_run_id
 from robohealth_mj.faults.injector import FaultInjector
 from robohealth_mj.recording.arm import ArmSimulator, TickChunk
-from robohealth_mj.schema import JOINT_NAMES, SCHEMA_VERSION, FaultLabel
+from robohealth_mj.schema import SCHEMA_VERSION, FaultLabel
 from robohealth_mj.sim.pushes import read_pushes
 from robohealth_mj.sim.twin_file import read_twin_noise
 
@@ -177,9 +177,8 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
     sensors = instantiate(cfg.sensors, physics_rate_hz=1.0 / model.opt.timestep, _convert_="all")
     # the drive's torque sensing resolves the same fraction of its rating on every arm (each
     # joint against its UR5e counterpart's)
-    ur = dict(zip(JOINT_NAMES, cfg.sim.reference_torque_nm, strict=True))
-    reference = np.array([ur[c] for c in description.ur_counterparts()], dtype=float)
-    sensors.effort_scale = description.rated_torque / reference
+    reference = np.asarray(cfg.sim.reference_torque_nm, dtype=float)
+    sensors.effort_scale = description.rated_torque / reference[description.ur_counterpart_index()]
     noise = read_twin_noise(cfg.sim.twin, description.name) if cfg.sim.get("twin") else None
     if noise is not None:  # a twin reads its effort as noisily as the real arm's current does
         sensors.effort_scale = noise / sensors.noise.effort

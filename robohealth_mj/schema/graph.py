@@ -135,10 +135,16 @@ class ArmGraph:
         return np.abs(idx[:, None] - idx[None, :])
 
     def type_flags(self) -> np.ndarray:
-        """The ``is_joint``/``is_sensor`` columns every sample carries, ``[N, 2]``."""
+        """The ``is_joint``/``is_sensor`` columns every sample carries, ``[N, 2]`` (read-only:
+        built once, as every sample's and every fleet tick's check reads it)."""
+        return self._flags
+
+    @cached_property
+    def _flags(self) -> np.ndarray:
         flags = np.zeros((self.n_nodes, 2), np.float32)
         flags[: self.n_joints, 0] = 1.0
         flags[self.n_joints :, 1] = 1.0
+        flags.setflags(write=False)
         return flags
 
     def as_dict(self) -> dict:

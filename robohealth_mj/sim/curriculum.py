@@ -172,7 +172,7 @@ class Curriculum:
             raise InputError(f"segment_s ({segment_s}) must be >= 2 * blend_s ({blend_s})")
         description = load_arm(DEFAULT_ARM) if arm is None else arm
         self.n_joints = description.n_joints
-        self._counterparts = [JOINT_NAMES.index(c) for c in description.ur_counterparts()]
+        self._counterparts = description.ur_counterpart_index()
         amplitude_rad = self._per_joint("amplitude_rad", amplitude_rad)
         center_jitter_rad = self._per_joint("center_jitter_rad", center_jitter_rad)
         own_home = description.joint_keys != JOINT_NAMES and len(home) != self.n_joints
@@ -200,6 +200,8 @@ class Curriculum:
         self.payload_ramp_s = float(payload_ramp_s)
         self.amplitude = self.amplitude * self.speed_ratio
         self._fit_ranges(description.position_limit)
+        self.lift = self._per_joint("lift", LIFT_RAD)  # pick and place: above the part
+        self.stroke = self._per_joint("stroke", CRUISE_STROKE_RAD)  # cruise: the via pose's reach
         unknown = sorted(set(families) - set(FAMILIES))
         if unknown or not families:
             raise InputError(f"curriculum.families must be a non-empty subset of {FAMILIES}")
@@ -299,7 +301,7 @@ class Curriculum:
             place = self.home + offset
         else:
             place = sched.center + rng.uniform(-0.4, 0.4, self.n_joints) * self.amplitude
-        lift = self._per_joint("lift", LIFT_RAD)
+        lift = self.lift
         return np.stack(
             [sched.start_pose, pick + lift, pick, pick + lift, place + lift, place, place + lift,
              sched.center]
