@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 from robohealth_mj import schema
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.data.arrays import common_graph, placed
 from robohealth_mj.data.jsonl import format_line, node_features
 from robohealth_mj.data.read import read_samples
 from robohealth_mj.schema import FaultLabel, SchemaError, validate_sample
@@ -166,3 +168,44 @@ def test_reader_reports_invalid_json_and_non_increasing_indices(tmp_path):
     path = _write(tmp_path / "order.jsonl", [good[1], good[0]])
     with pytest.raises(SchemaError, match=r"order.jsonl:2: field 'sample_index'"):
         list(read_samples(path))
+
+
+def test_arms_of_one_joint_count_named_apart_are_read_by_place_along_the_chain():
+    """A Franka's and a Kinova's seven joints carry other names: recordings of both load on the
+    positional graph (``chain_1`` … ``chain_7``), whose model reads any seven-joint arm and no
+    six-joint one; a model of one arm's names reads that arm only; arms of two joint counts
+    are one line naming both counts."""
+    fr3 = tuple(f"fr3_joint{k}" for k in range(1, 8))
+    gen3 = tuple(f"joint_{k}" for k in range(1, 8))
+    chain = common_graph({fr3, gen3})
+    assert chain == schema.ArmGraph.by_position(7) and chain.positional
+    assert chain.joints[0] == "chain_1" and chain.edges == schema.ArmGraph(fr3).edges
+    assert chain.reads(schema.ArmGraph(gen3)) and chain.reads(SEVEN)
+    assert not chain.reads(schema.UR_GRAPH) and not schema.ArmGraph(fr3).reads(SEVEN)
+    assert not schema.ArmGraph(fr3).positional
+    assert common_graph({fr3}) == schema.ArmGraph(fr3) and common_graph(set()) == schema.UR_GRAPH
+    with pytest.raises(InputError, match=r"one joint count expected .* arms of 6 and 7 joints"):
+        common_graph({fr3, schema.JOINT_NAMES})
+
+
+def test_a_six_joint_arm_sits_on_seven_places_without_the_upper_arm_roll():
+    """Training for transfer across joint counts: a UR's six joints take places 1, 2 and 4–7 of
+    a seven-joint chain (no third joint: the upper-arm roll), its sensor packages follow its
+    joints, the absent joint's nodes read zero but for the node-type flags, and a fault on the
+    elbow is a fault on place 4. Without ``pad`` the two counts are one line (above)."""
+    seven = schema.ArmGraph.by_position(7)
+    assert schema.UR_GRAPH.places_on(seven) == [0, 1, 3, 4, 5, 6]
+    assert schema.ArmGraph(("a", "b", "c", "d", "e")).places_on(seven) == [0, 1, 4, 5, 6]
+    assert common_graph({schema.JOINT_NAMES, tuple(f"j{k}" for k in range(7))}, pad=True) == seven
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(3, 12, schema.N_FEATURES)).astype(np.float32)
+    x[:, :, :2] = schema.UR_GRAPH.type_flags()
+    part = {"joints": np.array(schema.JOINT_NAMES), "x": x, "fault_joint": np.array([-1, 2, 5])}
+    out = placed(part, seven)
+    assert out["x"].shape == (3, 14, schema.N_FEATURES)
+    np.testing.assert_array_equal(out["x"][:, [0, 1, 3, 4, 5, 6]], x[:, :6])
+    np.testing.assert_array_equal(out["x"][:, [7, 8, 10, 11, 12, 13]], x[:, 6:])
+    np.testing.assert_array_equal(out["x"][:, [2, 9], 2:], 0.0)
+    np.testing.assert_array_equal(out["x"][0, :, :2], seven.type_flags())
+    np.testing.assert_array_equal(out["fault_joint"], [-1, 3, 6])
+    assert list(out["joints"]) == list(seven.joints)

@@ -135,10 +135,50 @@ def single_arm(paths: list[Path | str], arm: str | None = None, what: str = "dat
     return arms[0]
 
 
-def load_recordings(paths: list[Path | str], arm: str | None = None) -> Recording:
+def common_graph(graphs: set[tuple[str, ...]], pad: bool = False) -> ArmGraph:
+    """The one graph recordings of these arms' joint lists are read on: their own when they
+    share it, a positional one when their arms have as many joints named apart (the seven-joint
+    makers: a model fitted on several reads each by place along the chain). Arms of several
+    joint counts: with ``pad`` (training for transfer) the longest chain's positional graph, the
+    shorter arms' joints placed on it (:meth:`ArmGraph.places_on`); else one line."""
+    if not graphs:
+        return UR_GRAPH
+    if len(graphs) == 1:
+        return ArmGraph(next(iter(graphs)))
+    counts = sorted({len(g) for g in graphs})
+    if len(counts) == 1 or pad:
+        return ArmGraph.by_position(counts[-1])
+    shown = "; ".join(", ".join(g) for g in sorted(graphs))
+    raise InputError(
+        f"recordings of one joint count expected (one model reads one; transfer=true trains "
+        f"across counts); got arms of {' and '.join(map(str, counts))} joints: {shown}"
+    )
+
+
+def placed(part: dict[str, np.ndarray], graph: ArmGraph) -> dict[str, np.ndarray]:
+    """One file's arrays on a longer chain's graph: its joints and their sensor packages at
+    their places (:meth:`ArmGraph.places_on`), the absent joints' nodes all zero but for the
+    node-type flags, fault joints renumbered. An absent joint has no reading and no fault: a
+    graph model's messages pass it by its embedding alone, a booster reads it constant."""
+    own = ArmGraph(tuple(str(j) for j in part["joints"]))
+    if own.n_joints == graph.n_joints:
+        return part
+    at = np.array(own.places_on(graph))
+    x = np.zeros((len(part["x"]), graph.n_nodes, part["x"].shape[2]), np.float32)
+    x[:, :, :2] = graph.type_flags()
+    x[:, at] = part["x"][:, : own.n_joints]
+    x[:, graph.n_joints + at] = part["x"][:, own.n_joints :]
+    joint = np.where(part["fault_joint"] >= 0, at[np.maximum(part["fault_joint"], 0)], -1)
+    return {**part, "x": x, "fault_joint": joint, "joints": np.array(graph.joints)}
+
+
+def load_recordings(
+    paths: list[Path | str], arm: str | None = None, pad: bool = False
+) -> Recording:
     """Load (from cache when fresh) and concatenate recordings; run ids stay distinct; each
     file's torques and speeds relative to its arm's ratings (``arm``: the arm of files that
-    name none; default the reference arm)."""
+    name none; default the reference arm). Arms of several joint counts only with ``pad``: on
+    the longest chain by place (:func:`common_graph`, :func:`placed`)."""
     parts, arms = [], []
     for p in paths:
         part, name = _load_one(Path(p)), file_arm(p, arm)
@@ -146,10 +186,10 @@ def load_recordings(paths: list[Path | str], arm: str | None = None) -> Recordin
             part = {**part, "x": to_relative(part["x"], name)}
         parts.append(part)
         arms += [name] * len(part["run_ids"])
-    graphs = {tuple(str(j) for j in p.get("joints", UR_GRAPH.joints)) for p in parts}
-    if len(graphs) > 1:
-        shown = "; ".join(", ".join(g) for g in sorted(graphs))
-        raise InputError(f"recordings of one arm graph expected (one model reads one); got {shown}")
+    graph = common_graph(
+        {tuple(str(j) for j in p.get("joints", UR_GRAPH.joints)) for p in parts}, pad
+    )
+    parts = [placed({"joints": np.array(UR_GRAPH.joints), **p}, graph) for p in parts]
     run_ids: list[str] = []
     runs = []
     for part in parts:
@@ -176,7 +216,7 @@ def load_recordings(paths: list[Path | str], arm: str | None = None) -> Recordin
         run_ids=run_ids,
         sources=[str(p) for p in paths],
         arms=arms,
-        graph=ArmGraph(graphs.pop()) if graphs else UR_GRAPH,
+        graph=graph,
         **cat,
     )
 

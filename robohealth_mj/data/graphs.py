@@ -71,6 +71,15 @@ class GraphSpec:
         spec = harness_graph(c, arm=arm)
         return replace(spec, coupling_seed=self.coupling_seed)
 
+    def named_for(self, arm: schema.ArmGraph) -> GraphSpec:
+        """A positional graph (a model of several arms of one joint count) with ``arm``'s node
+        names: commissioned on that arm, the model is that arm's, and its diagnoses name its
+        joints. Any other graph is returned as it is."""
+        if not self.arm.positional or arm == self.arm or arm.n_joints != self.num_joints:
+            return self
+        names = dict(zip(self.arm.nodes, arm.nodes, strict=True))
+        return replace(self, node_names=tuple(names.get(n, n) for n in self.node_names), arm=arm)
+
     def with_sensing(self, profile) -> GraphSpec:
         """This graph reading only the channels ``profile`` (a SensingProfile) names; without
         sensor channels, without the sensor nodes."""

@@ -180,7 +180,7 @@ def commission(
             f"({', '.join(baseline.RESIDUALS)})"
         )
     record["contact"] = contact_record(arm, arm_name, trained.sensing, contact_margin)
-    graph = replace(trained, baseline_shift=delta)
+    graph = replace(trained.named_for(arm.graph), baseline_shift=delta)
     out_dir = Path(out_dir)
     model = model_from_checkpoint(ckpt)
     mean, std = ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()

@@ -227,7 +227,7 @@ def load_checked(ckpt: dict[str, Any], files: list, arm: str | None = None):
     from robohealth_mj.data.arrays import load_recordings
 
     check_recordings(ckpt, files)
-    rec = load_recordings(files, arm)
+    rec = load_recordings(files, arm, pad=bool(ckpt.get("transfer")))
     check_schema(ckpt, str(files[0]), rec.graph)
     return rec
 
@@ -248,7 +248,7 @@ def check_schema(ckpt: dict[str, Any], source: str, graph: schema.ArmGraph | Non
         raise InputError(f"{source}: key 'schema.node_names': {exc}") from None
     if s["edges"] != [list(e) for e in trained.edges]:
         raise InputError(f"{source}: graph topology differs from the checkpoint's arm graph")
-    if graph is not None and graph != trained:
+    if graph is not None and not trained.reads(graph):
         raise InputError(
             f"{source}: an arm of joints {list(graph.joints)}; the model was trained on "
             f"{list(trained.joints)}"

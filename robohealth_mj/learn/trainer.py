@@ -68,7 +68,9 @@ def finished_on_current_data(cfg: DictConfig, out_dir: Path) -> bool:
         heldout = (cfg.data.evaluate or {}).get("heldout")
         fresh = (
             summary.get("data_fingerprint")
-            == load_recordings(expand_paths(cfg.data.train)).fingerprint()
+            == load_recordings(
+                expand_paths(cfg.data.train), pad=bool(cfg.get("transfer", False))
+            ).fingerprint()
         )
         if heldout:
             fresh &= (
@@ -125,7 +127,7 @@ def prepare(cfg: DictConfig) -> Prepared:
     sensing = instantiate(cfg.sensing)
     files = expand_paths(cfg.data.train)
     check_transfer(cfg, files)
-    rec = load_recordings(files)
+    rec = load_recordings(files, pad=bool(cfg.get("transfer", False)))  # across joint counts
     graph = graph.for_arm(rec.graph).with_sensing(sensing)  # the recordings' arm's graph
     rec = graph.relabel(rec)
     rec = label_windows(rec, int(cfg.window), str(cfg.get("labels", "last")))

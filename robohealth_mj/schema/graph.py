@@ -45,6 +45,7 @@ FEATURE_NAMES: tuple[str, ...] = ("is_joint", "is_sensor", *STATE_FEATURES, *SEN
 N_JOINTS = len(JOINT_NAMES)
 N_NODES = len(NODE_NAMES)
 N_FEATURES = len(FEATURE_NAMES)
+CHAIN_PREFIX = "chain_"  # a positional graph's joints (ArmGraph.by_position): chain_1 … chain_J
 # The per-channel statistics a model pools each window into (models/statistics.py computes them in
 # torch, runtime/incremental.py from running sums; both read the names here).
 WINDOW_STATISTICS: tuple[str, ...] = (
@@ -155,6 +156,36 @@ class ArmGraph:
             "features": list(FEATURE_NAMES),
             "edges": [list(e) for e in self.edges],
         }
+
+    @classmethod
+    def by_position(cls, n_joints: int) -> ArmGraph:
+        """The graph of a model trained on several arms of one joint count whose joints are
+        named apart (a Franka's ``fr3_joint1``, a Kinova's ``joint_1``): its joints are named by
+        their place along the chain, base to tool (``chain_1`` …), and it reads any arm of
+        ``n_joints`` joints by that place, as its weights were fitted."""
+        return cls(tuple(f"{CHAIN_PREFIX}{k + 1}" for k in range(n_joints)))
+
+    @property
+    def positional(self) -> bool:
+        """Whether this is a :meth:`by_position` graph."""
+        return self == ArmGraph.by_position(self.n_joints)
+
+    def reads(self, data: ArmGraph) -> bool:
+        """Whether a model trained on this graph reads data on ``data``: the same graph, or any
+        arm of as many joints when this one is positional."""
+        return self == data or (self.positional and data.n_joints == self.n_joints)
+
+    def places_on(self, longer: ArmGraph) -> list[int]:
+        """Where this arm's joints sit along a longer chain, read by place (:meth:`by_position`):
+        the base two (the shoulder's pan and lift on every arm here) first, the rest with the
+        tool joint last; the joints between, which this arm lacks, read as absent. A six-joint
+        UR on seven places has no third joint: the upper-arm roll the seven-joint arms add
+        between shoulder and elbow."""
+        short, long = self.n_joints, longer.n_joints
+        if short > long:
+            raise ValueError(f"{short} joints do not sit on a chain of {long}")
+        head = min(2, short)
+        return list(range(head)) + list(range(long - (short - head), long))
 
     @classmethod
     def of_nodes(cls, nodes: Sequence[str]) -> ArmGraph:

@@ -2,7 +2,8 @@
 commissioning, and false alarms on the unseen arm's healthy hour.
 
     python studies/arms/campaign.py [--variants gbdt,stgnn_fixed] [--seeds 42,43,44]
-        [--epochs 10] [--sensing full] [--arms ur3e,ur5e,ur10e,ur16e] [--stages own,loao]
+        [--epochs 10] [--sensing full] [--arms ur3e,ur5e,ur10e,ur16e] [--family ARMS]
+        [--stages own,loao]
         [--steps train,rescore,commission,alarms] [--healthy-rate 0.99]
 
 Reads the per-arm corpora ``outputs/corpus/arms/<arm>`` (``python -m robohealth_mj.corpus
@@ -10,7 +11,7 @@ corpus=arms ...``, see ``studies/arms/run.sh``; ``--corpus`` names another root,
 with more training sessions per arm) and writes under ``outputs/campaign_arms``:
 
 - ``own/<arm>/...``: each arm's own models (trained on its sessions, scored on its held-out one);
-- ``loao/<arm>/...``: models trained with ``transfer=true`` on the three other arms, scored on
+- ``loao/<arm>/...``: models trained with ``transfer=true`` on the family's other arms, scored on
   ``<arm>``'s held-out session; ``commissioned/`` beside each: the model commissioned on ten
   minutes of ``<arm>``'s healthy running and scored again; networks are also replayed through the
   fleet runtime and the monitor's alarms over ``<arm>``'s healthy hour
@@ -148,6 +149,11 @@ def main() -> None:
     parser.add_argument("--epochs", type=int, default=10)
     parser.add_argument("--sensing", default="full")
     parser.add_argument("--arms", default=",".join(ARMS))
+    parser.add_argument(
+        "--family",
+        help="the arms leave-one-arm-out trains on, less the one left out (default: --arms); "
+        "arms of one joint count named apart are read by place along the chain",
+    )
     parser.add_argument("--stages", default="own,loao", help="own, loao or both")
     parser.add_argument(
         "--steps",
@@ -179,8 +185,9 @@ def main() -> None:
     )
     args = parser.parse_args()
     arms = args.arms.split(",")
+    family = (args.family or args.arms).split(",")
     root: Path = args.corpus
-    missing = [a for a in arms if not (root / a / "corpus.json").is_file()]
+    missing = [a for a in dict.fromkeys(arms + family) if not (root / a / "corpus.json").is_file()]
     if missing:
         raise SystemExit(
             f"no corpus for {', '.join(missing)}: python -m robohealth_mj.corpus corpus=arms "
@@ -197,7 +204,7 @@ def main() -> None:
             for run_dir in runs(own, variants):
                 rescore(run_dir, root / arm)
         if "loao" in stages:
-            others = [f"{root}/{a}/train_*" for a in ARMS if a != arm]
+            others = [f"{root}/{a}/train_*" for a in family if a != arm]
             sweep = args.out / args.sensing / "loao" / arm
             if "train" in steps:
                 train(sweep, others, heldout, args, "transfer=true")

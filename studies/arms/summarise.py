@@ -1,10 +1,10 @@
 """The cross-arm table from the campaign's evaluations (``studies/arms/campaign.py``).
 
     python studies/arms/summarise.py [--sensing full] [--out DIR] [--seeds 42]
-        [--healthy-rate 0.99] [--against DIR]
+        [--healthy-rate 0.99] [--against DIR] [--own DIR]
 
 One row per held-out arm and variant: the arm's own model; the leave-one-arm-out model (trained
-with ``transfer=true`` on the three other arms) before and after commissioning on ten minutes
+with ``transfer=true`` on the family's other arms) before and after commissioning on ten minutes
 of the arm's healthy running; the commissioned network's false alarms over the arm's healthy
 hour (the monitor's replay with its default alarm policy). Mean ± std over the seeds found.
 Then each network against ``gbdt`` after commissioning: ahead when the difference of the means
@@ -56,17 +56,19 @@ def collect(
     out: Path = OUT,
     seeds: set[str] | None = None,
     commissioned: str = "commissioned",
+    own: Path | None = None,
 ) -> dict[tuple[str, str], dict[str, list[float]]]:
     """``(arm, variant) -> {column: [one value per seed]}`` (``seeds``: only these, e.g.
     ``{"42"}``, to set one seed of two campaigns side by side; ``commissioned``: the directory
-    of the commissioned models to read)."""
+    of the commissioned models to read; ``own``: the campaign root of the arms' own models,
+    default ``out``)."""
     table: dict[tuple[str, str], dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
-    for stage in ("own", "loao"):
-        for ev in sorted((out / sensing / stage).glob("*/**/seed*/eval_heldout.json")):
+    for stage, root in (("own", own or out), ("loao", out)):
+        for ev in sorted((root / sensing / stage).glob("*/**/seed*/eval_heldout.json")):
             run = ev.parent
             if seeds is not None and run.name.removeprefix("seed") not in seeds:
                 continue
-            arm = run.relative_to(out / sensing / stage).parts[0]
+            arm = run.relative_to(root / sensing / stage).parts[0]
             variant = run.parts[-3]
             row = table[(arm, variant)]
             m = _metrics(ev)
@@ -238,11 +240,17 @@ def main() -> None:
     parser.add_argument(
         "--against", type=Path, help="another campaign root to set each model beside"
     )
+    parser.add_argument(
+        "--own",
+        type=Path,
+        help="the campaign root of the arms' own models (default --out), e.g. the seven-joint "
+        "campaign's for the family's leave-one-arm-out",
+    )
     args = parser.parse_args()
     seeds = set(args.seeds.split(",")) if args.seeds else None
     rate = args.healthy_rate
     commissioned = "commissioned" if rate is None else f"commissioned_hr{rate:g}"
-    table = collect(args.sensing, args.out, seeds, commissioned)
+    table = collect(args.sensing, args.out, seeds, commissioned, args.own)
     if not table:
         raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
     RESULTS.mkdir(parents=True, exist_ok=True)

@@ -16,7 +16,9 @@ from robohealth_mj.common.config import compose_config
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.relative import channel_scale, to_raw, to_relative
+from robohealth_mj.deploy.commission import commission
 from robohealth_mj.deploy.export import export_checkpoint
+from robohealth_mj.learn.checkpoint import checkpoint_arm, load_checkpoint
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
 from robohealth_mj.learn.run import train_and_evaluate
 from robohealth_mj.recording.recorder import record_session
@@ -128,3 +130,36 @@ def test_a_model_reads_an_unseen_arm_only_when_trained_for_transfer(tmp_path, fa
         return session.run(None, {"x": raw})[0]
 
     assert not np.allclose(logits(for_ur3e["path"]), logits(for_ur5e["path"]), atol=1e-3)
+
+
+@pytest.mark.slow  # records six sessions, fits one booster
+def test_arms_of_two_joint_counts_train_one_model_that_reads_a_third(tmp_path, fast_session):
+    """A Franka's, a KUKA's and a UR5e's recordings train one model on the seven-joint positional
+    graph (the UR's joints placed on it); it scores a Kinova it never saw, and commissioned on
+    the Kinova's healthy running (its reference the three arms' data, placed again) it is the
+    Kinova's model: its checkpoint names the Kinova's joints and refuses the Franka's."""
+    session = [o for o in fast_session if not o.startswith("faults.schedule.joints")]
+    for arm, seed in (("fr3", 1), ("fr3", 2), ("iiwa14", 3), ("ur5e", 6)):
+        _record(tmp_path / "train", arm, seed, session)
+    unseen = _record(tmp_path, "gen3", 4, session)
+    healthy = _record(tmp_path, "gen3", 5, ["faults=none", "session.duration_s=30",
+                                            "session.progress=false"])  # fmt: skip
+    cfg = compose_config("train", [
+        f"data.train=[{tmp_path}/train/*]", "data.evaluate.heldout=null", "variant=gbdt",
+        "data.evaluate.probe=null", "trainer.progress=false", "window=8", "transfer=true",
+    ])  # fmt: skip
+    train_and_evaluate(cfg, tmp_path / "model")
+    model = tmp_path / "model" / "best.ckpt"
+    assert checkpoint_arm(load_checkpoint(model)) == schema.ArmGraph.by_position(7)
+    metrics = evaluate_checkpoint(model, str(unseen))["metrics"]
+    assert 0.0 <= metrics["localisation_accuracy"] <= 1.0
+
+    commission(model, str(healthy), tmp_path / "gen3", export=False)
+    kinova = load_recordings([unseen]).graph
+    assert kinova.joints[0] == "joint_1" and not kinova.positional
+    commissioned = tmp_path / "gen3" / "best.ckpt"
+    assert checkpoint_arm(load_checkpoint(commissioned)) == kinova
+    again = evaluate_checkpoint(commissioned, str(unseen))["metrics"]
+    assert 0.0 <= again["accuracy"] <= 1.0
+    with pytest.raises(InputError, match=r"an arm of joints .*fr3_joint1.*trained on .*joint_1"):
+        evaluate_checkpoint(commissioned, str(next((tmp_path / "train").glob("fr3*"))))
