@@ -186,10 +186,9 @@ def load_recordings(
             part = {**part, "x": to_relative(part["x"], name)}
         parts.append(part)
         arms += [name] * len(part["run_ids"])
-    graph = common_graph(
-        {tuple(str(j) for j in p.get("joints", UR_GRAPH.joints)) for p in parts}, pad
-    )
-    parts = [placed({"joints": np.array(UR_GRAPH.joints), **p}, graph) for p in parts]
+    parts = [{"joints": np.array(UR_GRAPH.joints), **p} for p in parts]  # a 2.0 file: the UR's
+    graph = common_graph({tuple(str(j) for j in p["joints"]) for p in parts}, pad)
+    parts = [placed(p, graph) for p in parts]
     run_ids: list[str] = []
     runs = []
     for part in parts:
