@@ -36,6 +36,7 @@ from robohealth_mj.learn.checkpoint import save_checkpoint, training_arms
 from robohealth_mj.learn.data import WindowTensors
 from robohealth_mj.learn.loss import loss_from_config
 from robohealth_mj.learn.metrics import metrics_of
+from robohealth_mj.learn.motion_placement import training_placement
 from robohealth_mj.learn.placements import PlacementPool, given_placement, placement_pool
 from robohealth_mj.learn.predict import predict
 from robohealth_mj.models import build_model
@@ -138,6 +139,9 @@ def prepare(cfg: DictConfig) -> Prepared:
     model = build_model(
         cfg.model, graph.adjacency, graph.num_joints, schema.N_FEATURES, int(cfg.window)
     ).to(device)
+    head = getattr(model, "anomaly", None)
+    if head is not None and head.coupling_fit == "motion" and not cfg.trainer.get("placements"):
+        head.set_coupling(training_placement(rec, splits["train"], graph))  # frozen from here
     pool = None
     if cfg.trainer.get("placements"):
         pool = placement_pool(

@@ -75,7 +75,17 @@ class AnomalyResidualHead(nn.Module):
     with an *inverted* C: the anomalous sensor scored low and the joint coupled to it *least*
     winning. ``scores="energy"`` scores ``||W r_m||^2 / H``: zero for a sensor predicted exactly,
     growing with its residual, so the joint that wins is the one coupled most to the sensors
-    that deviate, which pins C's sign.
+    that deviate, which pins C's sign *given* the embeddings; but the residual is a learned
+    embedding, so a network can still make the faulted sensor's residual small and the others'
+    large and learn an inverted C (it did, at a reconstruction weight of 1.0).
+
+    ``coupling_fit="motion"`` pins the sign by construction: ``C`` is not trained. Training
+    sets it once, before the first step, to the motion estimate of the placement on the
+    training data's healthy running (:mod:`robohealth_mj.learn.motion_placement`, the
+    estimator commissioning uses): each entry a non-negative least-squares weight of how much
+    of a joint's motion-predicted emission a sensor carries. It stays frozen, so no loss can
+    move it, and with energy scores (``>= 0``) a sensor's deviation can only raise the logits of
+    the joints it carries. ``coupling_fit="losses"`` (the thesis): every loss trains ``C``.
 
     ``joint_scores`` adds a per-joint score ``v(h_j)`` from each joint's own embedding. Told a
     placement (a pool model), the scattered scores alone are a fixed function of the sensors'
@@ -84,6 +94,7 @@ class AnomalyResidualHead(nn.Module):
     """
 
     SCORES = ("signed", "energy")
+    FITS = ("losses", "motion")
 
     def __init__(
         self,
@@ -93,13 +104,20 @@ class AnomalyResidualHead(nn.Module):
         init_noise: float = 0.01,
         scores: str = "signed",
         joint_scores: bool = False,
+        coupling_fit: str = "losses",
     ) -> None:
         super().__init__()
         if scores not in self.SCORES:
             raise InputError(f"model.anomaly_scores must be one of {self.SCORES}, got {scores!r}")
+        if coupling_fit not in self.FITS:
+            raise InputError(f"model.coupling_fit must be one of {self.FITS}, got {coupling_fit!r}")
+        self.coupling_fit = coupling_fit
         self.num_joints, self.num_sensors = num_joints, num_sensors
         self.init_noise = float(init_noise)
-        self.coupling_logits = nn.Parameter(torch.empty(num_joints, num_sensors))
+        # frozen under the motion fit: set once before training, never a loss's to move
+        self.coupling_logits = nn.Parameter(
+            torch.empty(num_joints, num_sensors), requires_grad=coupling_fit == "losses"
+        )
         self.f = mlp(hidden, hidden, hidden)
         self.scores = scores
         self.g = mlp(hidden, hidden, 1) if scores == "signed" else nn.Linear(hidden, hidden, False)

@@ -50,6 +50,7 @@ class STGNN(nn.Module):
         anomaly_scores: str = "signed",
         coupled_edges: bool = False,
         anomaly_joint_scores: bool = False,
+        coupling_fit: str = "losses",
         placement_embedding: bool = False,
         severity_head: bool = False,
         pos_index: int = schema.feature_index("pos"),
@@ -86,6 +87,7 @@ class STGNN(nn.Module):
                 n - num_joints,
                 scores=anomaly_scores,
                 joint_scores=anomaly_joint_scores,
+                coupling_fit=coupling_fit,
             )
             if anomaly_head
             else None

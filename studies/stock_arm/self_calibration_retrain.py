@@ -31,9 +31,9 @@ import torch
 
 from robohealth_mj.data.arrays import Recording, expand_paths, load_recordings
 from robohealth_mj.data.graphs import coupling_correlation, harness_graph
-from robohealth_mj.deploy.recouple import motion_estimate
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
 from robohealth_mj.learn.evaluation import score_under_placement
+from robohealth_mj.learn.motion_placement import motion_estimate
 
 CORPUS = os.environ.get("CORPUS", "outputs/corpus/standard")
 RUNS = Path("outputs/thesis_physics/harness/retrofit")

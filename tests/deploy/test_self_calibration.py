@@ -18,13 +18,10 @@ from robohealth_mj.common.config import compose_config
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.graphs import DEFAULT_C0, coupling_correlation, harness_graph, load_coupling
 from robohealth_mj.deploy.commission import commission
-from robohealth_mj.deploy.recouple import (
-    motion_estimate,
-    reconstruction_estimate,
-    sparse_mixture,
-)
+from robohealth_mj.deploy.recouple import reconstruction_estimate
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checkpoint
 from robohealth_mj.learn.checkpoint import model_from_checkpoint as build
+from robohealth_mj.learn.motion_placement import motion_estimate, sparse_mixture
 from robohealth_mj.learn.placements import (
     PlacementPool,
     healthy_sensor_statistics,
@@ -295,3 +292,30 @@ def test_a_commissioned_self_calibrating_model_streams_as_it_scores_windows(
     assert (~np.isnan(probs[0])).sum() > 100
     np.testing.assert_array_equal(np.isnan(probs[0]), np.isnan(probs[1]))
     assert np.nanmax(np.abs(probs[0] - probs[1])) <= 1e-4
+
+
+def test_training_with_the_motion_fit_sets_the_placement_once_and_never_moves_it(
+    tiny_corpus, tmp_path
+):
+    """``model.coupling_fit=motion`` (issue 69): the trained model's C is the motion estimate on
+    the healthy running its training windows cover, set before the first step and unchanged by
+    training; it reads the drawn placement with the right sign (its correlation is positive and
+    recorded with the run)."""
+    from robohealth_mj.learn.motion_placement import training_placement
+    from robohealth_mj.learn.trainer import prepare
+
+    cfg = compose_config("train", [
+        f"data.train=[{tiny_corpus}/train_*]", f"data.evaluate.heldout={tiny_corpus}/heldout",
+        "data.evaluate.probe=null", "trainer.progress=false", "graph=harness",
+        "graph.coupling_seed=3", "window=8", "variant=anomaly_residual", "model.hidden=8",
+        "model.coupling_fit=motion", "model.anomaly_scores=energy", "trainer.epochs=2",
+    ])  # fmt: skip
+    results = run(cfg, tmp_path)
+    trained = build(load_checkpoint(tmp_path / "best.ckpt")).anomaly.coupling().detach().numpy()
+    p = prepare(cfg)
+    fitted = training_placement(p.rec, p.splits["train"], p.graph)
+    np.testing.assert_allclose(trained, np.maximum(fitted, 1e-2), rtol=1e-4, atol=1e-5)
+    truth = harness_graph(coupling_seed=3).coupling
+    corr = coupling_correlation(trained, truth)
+    assert corr > 0.5
+    assert results["train"]["coupling_correlation"] == pytest.approx(corr, abs=1e-4)

@@ -387,3 +387,39 @@ def test_a_pool_model_with_every_option_exports_to_onnx_with_its_placement(tmp_p
     export_onnx(model, torch.randn(2, 16, 10, F), path)
     for batch in (1, 5):
         assert onnx_parity(model, path, torch.randn(batch, 16, 10, F)) < 1e-4
+
+
+def test_a_motion_fitted_coupling_is_frozen_whatever_the_losses_reward():
+    """``coupling_fit=motion``: C is set before training and no loss moves it, even labels that
+    blame, in every window, the joint coupled *least* (labels that reward an inverted C); under
+    ``losses`` the same steps move it. An unknown fit is one line."""
+    from robohealth_mj.learn.data import WindowBatch
+    from robohealth_mj.learn.loss import training_loss
+    from robohealth_mj.models.heads import AnomalyResidualHead
+
+    graph = harness_graph(coupling_seed=3)
+    n = 16
+    healthy = torch.arange(n) % 2 == 0
+    least = torch.as_tensor(graph.coupling.sum(axis=1).argmin()).repeat(n)
+    batch = WindowBatch(
+        x=torch.randn(n, 8, 10, F),
+        fault_class=torch.where(healthy, 0, 1),
+        fault_joint=torch.where(healthy, -1, least),
+        active=~healthy,
+        severity=torch.zeros(n),
+    )
+    for fit, moves in (("motion", False), ("losses", True)):
+        model = _build(
+            "anomaly_residual", adjacency=graph.adjacency, coupling_fit=fit, coupled_edges=True
+        ).train()
+        model.anomaly.set_coupling(graph.coupling)
+        before = model.anomaly.coupling().detach().clone()
+        optimiser = torch.optim.AdamW(model.parameters(), lr=0.05, weight_decay=0.01)
+        for _ in range(5):
+            optimiser.zero_grad()
+            training_loss(model(batch.x), batch, 5.0, 1.0, 0.0)[0].backward()
+            optimiser.step()
+        moved = not torch.equal(model.anomaly.coupling().detach(), before)
+        assert moved == moves, fit
+    with pytest.raises(ValueError, match="coupling_fit must be one of"):
+        AnomalyResidualHead(8, 6, 4, coupling_fit="inputs")

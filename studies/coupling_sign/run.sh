@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Issue 69: the coupling whose sign is pinned by construction (model.coupling_fit=motion) against
+# the thesis's learned one, on the unknown-placement harness. One part per argument, runs into
+# outputs/coupling_sign (a finished run is skipped, so a part resumes after interruption):
+#   bash studies/coupling_sign/run.sh fits default placements weights pose summary
+# fits: the motion fit alone (no training) on placements 1-10, full profile, split seed 42
+# (the fit reads position, velocity and the sensors, which retrofit keeps: the same C; and
+# C0's fit is the same to 3 decimals on seeds 42-44; FIT_SEEDS="42 43 44" for all three);
+# default: anomaly_residual on the default placement C0, full and retrofit, seeds 42-44 (Table 8);
+# placements: anomaly_residual on placements 1, 2, 3, 5 (those of studies/thesis_physics), seed 42;
+# weights: the reconstruction weight at WEIGHTS (default "0.3 1.0"), both fits (C0, full, seed 42);
+# pose: pose_anomaly as default, seeds SEEDS (default "42 43 44");
+# joint: the motion fit with a per-joint score beside the scattered ones (model.anomaly_joint_scores),
+# which breaks the tie of joints a sparse placement couples alike: placements 1 and 2, full, then
+# C0 full and placement 1 retrofit (seed 42).
+# JOBS parallel runs of one thread each (default 2, for 2 cores).
+set -euo pipefail
+PY=${PY:-.venv/bin/python}
+JOBS=${JOBS:-2}
+ROOT=${ROOT:-outputs/coupling_sign}
+CORPUS=${CORPUS:-outputs/corpus/standard}
+HERE=studies/coupling_sign
+
+run() {  # out_dir, then overrides: one training run of one thread
+  local out=$1; shift
+  $PY -m robohealth_mj.train graph=harness window=32 model.anomaly_scores=energy \
+    trainer.threads=1 trainer.progress=false "data.train=[$CORPUS/train_*]" \
+    data.evaluate.heldout="$CORPUS/heldout_seed900" '~data.evaluate.probe' \
+    out_dir="$ROOT/$out" "$@" >"$ROOT/logs/${out//\//_}.log" 2>&1 || echo "failed: $out" >&2
+}
+export -f run
+export PY ROOT CORPUS
+parallel_runs() {  # lines of "out_dir override ..." on stdin, JOBS at a time
+  mkdir -p "$ROOT/logs"
+  xargs -P "$JOBS" -L 1 bash -c 'run "$@"' _
+}
+for part in "$@"; do
+  case $part in
+    fits) seeds=${FIT_SEEDS:-42}
+          $PY $HERE/placement_fits.py --corpus "$CORPUS" --out $HERE/results/fits.json \
+            --seeds "${seeds// /,}" --profiles full ;;
+    default)
+      for seed in 42 43 44; do for s in full retrofit; do for fit in motion losses; do
+        [ $fit = losses ] && continue  # the thesis's rows: studies/thesis_physics (same recipe)
+        echo "default/$s/C0/anomaly_residual_$fit/seed$seed variant=anomaly_residual" \
+          "sensing=$s seed=$seed model.coupling_fit=$fit"
+      done; done; done | parallel_runs ;;
+    placements)
+      for p in 1:3 2:4 3:6 5:4; do for s in full retrofit; do
+        echo "placements/$s/seed${p%:*}_m${p#*:}/anomaly_residual_motion/seed42" \
+          "variant=anomaly_residual sensing=$s seed=42 model.coupling_fit=motion" \
+          "graph.coupling_seed=${p%:*} graph.coupling_sensors=${p#*:}"
+      done; done | parallel_runs ;;
+    weights)
+      for w in ${WEIGHTS:-0.3 1.0}; do for fit in motion losses; do
+        echo "weights/full/C0/anomaly_residual_${fit}_w$w/seed42 variant=anomaly_residual" \
+          "sensing=full seed=42 model.coupling_fit=$fit trainer.recon_loss_weight=$w"
+      done; done | parallel_runs ;;
+    pose)
+      for seed in ${SEEDS:-42 43 44}; do for s in full retrofit; do
+        echo "default/$s/C0/pose_anomaly_motion/seed$seed variant=pose_anomaly sensing=$s" \
+          "seed=$seed model.coupling_fit=motion"
+      done; done | parallel_runs ;;
+    joint)
+      for p in seed1_m3:full:1:3 seed2_m4:full:2:4 C0:full: seed1_m3:retrofit:1:3; do
+        IFS=: read -r name s cs cm <<<"$p"
+        place=""
+        [ -n "$cs" ] && place="graph.coupling_seed=$cs graph.coupling_sensors=$cm"
+        part=placements; [ "$name" = C0 ] && part=default
+        # no trailing blank: xargs -L would join the next line to this one
+        echo "$part/$s/$name/anomaly_residual_motion_joint/seed42 variant=anomaly_residual" \
+          "sensing=$s seed=42 model.coupling_fit=motion model.anomaly_joint_scores=true${place:+ $place}"
+      done | parallel_runs ;;
+    summary) $PY $HERE/summarise.py --root "$ROOT" --out $HERE/results/results.md ;;
+    *) echo "unknown part: $part" >&2; exit 2 ;;
+  esac
+done

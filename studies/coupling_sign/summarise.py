@@ -1,0 +1,168 @@
+"""The tables of ``studies/coupling_sign/results/results.md`` from the runs (issue 69).
+
+    python studies/coupling_sign/summarise.py [--root outputs/coupling_sign] [--out FILE]
+
+Reads this study's runs (``run.sh``: the motion-fitted coupling, ``model.coupling_fit=motion``),
+the thesis rerun's committed runs of the same recipe with the coupling every loss trains
+(``studies/thesis_physics/results/runs/harness``: ``losses``) and ``gbdt`` beside them, and the
+placement fits without training (``results/fits.json``). Validation figures are the best
+epoch's (what selection saw); held-out figures are the standard held-out session's.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from robohealth_mj.common.atomic import atomic_write_text
+
+THESIS = Path("studies/thesis_physics/results/runs/harness")
+FITS = Path("studies/coupling_sign/results/fits.json")
+
+
+def run_row(run: Path) -> dict | None:
+    """One run's figures, or None when it has not finished."""
+    try:
+        summary = json.loads((run / "train_summary.json").read_text())
+        heldout = json.loads((run / "eval_heldout.json").read_text())["metrics"]
+    except FileNotFoundError:
+        return None
+    best = {h["epoch"]: h for h in summary.get("history") or []}.get(summary["best_epoch"], {})
+    return {
+        "val_acc": best.get("val_accuracy"),
+        "val_loc": best.get("val_localisation"),
+        "acc": heldout["accuracy"],
+        "loc": heldout["localisation_accuracy"],
+        "corr": summary.get("coupling_correlation"),
+        "seconds": summary.get("wall_seconds"),
+    }
+
+
+def mean_std(values: list[float | None]) -> str:
+    v = np.array([x for x in values if x is not None], float)
+    if not len(v):
+        return "–"
+    return f"{v.mean():.3f}" if len(v) == 1 else f"{v.mean():.3f} ± {v.std(ddof=1):.3f}"
+
+
+def table(rows: list[tuple[str, list[dict]]]) -> list[str]:
+    out = [
+        "| run | n | val acc | val loc | held-out acc | held-out loc | corr(C, C0) | s / run |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for name, runs in rows:
+        if not runs:
+            continue
+        cols = [mean_std([r[k] for r in runs]) for k in ("val_acc", "val_loc", "acc", "loc")]
+        corr = mean_std([r["corr"] for r in runs])
+        secs = np.mean([r["seconds"] or 0 for r in runs])
+        out.append(f"| {name} | {len(runs)} | {' | '.join(cols)} | {corr} | {secs:.0f} |")
+    return out
+
+
+def runs_of(pattern: str, root: Path) -> list[dict]:
+    return [r for p in sorted(root.glob(pattern)) if (r := run_row(p)) is not None]
+
+
+def fits_section() -> list[str]:
+    if not FITS.is_file():
+        return ["(no placement fits: run `bash studies/coupling_sign/run.sh fits`)"]
+    fits = json.loads(FITS.read_text())["fits"]
+    corr = np.array([f["coupling_correlation"] for f in fits])
+    rows = np.array([f["rows"] for f in fits])
+    per_row = ", ".join(
+        f"joint {j + 1} {rows[:, j].mean():.2f} / {rows[:, j].min():.2f}"
+        for j in range(rows.shape[1])
+    )
+    lines = [
+        f"{len(fits)} fits (placements × profiles × split seeds): corr(C, C0) mean "
+        f"{corr.mean():.3f}, min {corr.min():.3f}, max {corr.max():.3f}; "
+        f"sign wrong (≤ 0) in {(corr <= 0).sum()}; below 0.9 in {(corr < 0.9).sum()}.",
+        f"Per joint row (mean / min over the fits): {per_row}.",
+        "",
+    ]
+    profiles = list(dict.fromkeys(f["sensing"] for f in fits))
+    lines += [
+        "| placement | " + " | ".join(f"{p}: corr per split seed" for p in profiles) + " |",
+        "|---|" + "---|" * len(profiles),
+    ]
+    for placement in dict.fromkeys(f["placement"] for f in fits):
+        by = [
+            " ".join(
+                f"{f['coupling_correlation']:.3f}"
+                for f in fits
+                if f["placement"] == placement and f["sensing"] == profile
+            )
+            for profile in profiles
+        ]
+        lines.append(f"| {placement} | {' | '.join(by)} |")
+    return lines
+
+
+HEADER = (
+    "Made by `bash studies/coupling_sign/run.sh fits default placements joint summary` (W = 32, "
+    "energy scores, 20 epochs, one thread per run, two runs side by side; the parts `weights` "
+    "and `pose` add rows below when run). `losses`: "
+    "the coupling every loss trains (the committed thesis rerun, same recipe); `motion`: set "
+    "before training by the motion fit on the training data's healthy running, then frozen; "
+    "`+ joint scores`: with `model.anomaly_joint_scores=true` (a score from each joint's own "
+    "embedding beside the scattered ones)."
+)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--root", type=Path, default=Path("outputs/coupling_sign"))
+    parser.add_argument("--out", type=Path, default=FITS.with_name("results.md"))
+    args = parser.parse_args()
+
+    def ours(pattern: str) -> list[dict]:
+        return runs_of(pattern, args.root)
+
+    def thesis(pattern: str) -> list[dict]:
+        return runs_of(pattern, THESIS)
+
+    lines = ["# The sign-pinned coupling (issue 69)", "", HEADER, ""]
+    lines += ["## Placements without training", "", *fits_section(), ""]
+    for pr in ("full", "retrofit"):
+        lines += [f"## Default placement C0, {pr} profile, seeds 42–44", ""]
+        lines += table([
+            ("gbdt", thesis(f"{pr}/C0/gbdt/w32/seed*")),
+            ("anomaly_residual, losses", thesis(f"{pr}/C0/anomaly_residual/w32/seed*")),
+            ("anomaly_residual, motion", ours(f"default/{pr}/C0/anomaly_residual_motion/seed*")),
+            ("anomaly_residual, motion + joint scores",
+             ours(f"default/{pr}/C0/anomaly_residual_motion_joint/seed*")),
+            ("pose_anomaly, losses", thesis(f"{pr}/C0/pose_anomaly/w32/seed*")),
+            ("pose_anomaly, motion", ours(f"default/{pr}/C0/pose_anomaly_motion/seed*")),
+        ])  # fmt: skip
+        lines.append("")
+    lines += ["## Drawn placements, seed 42", ""]
+    for pr in ("full", "retrofit"):
+        rows = []
+        for place in sorted(p.name for p in (args.root / "placements" / pr).glob("seed*")):
+            rows += [
+                (f"{place} gbdt", thesis(f"{pr}/{place}/gbdt/w32/seed42")),
+                (f"{place} losses", thesis(f"{pr}/{place}/anomaly_residual/w32/seed42")),
+                (f"{place} motion", ours(f"placements/{pr}/{place}/*_motion/seed42")),
+                (f"{place} motion + joint scores", ours(f"placements/{pr}/{place}/*_joint/seed42")),
+            ]  # fmt: skip
+        lines += [f"### {pr}", "", *table(rows), ""]
+    lines += ["## Reconstruction weight (C0, full, seed 42)", ""]
+    weights = [
+        ("0.1 losses", thesis("full/C0/anomaly_residual/w32/seed42")),
+        ("0.1 motion", ours("default/full/C0/anomaly_residual_motion/seed42")),
+    ]
+    for w in ("0.3", "1.0"):
+        for fit in ("losses", "motion"):
+            runs = ours(f"weights/full/C0/anomaly_residual_{fit}_w{w}/seed42")
+            weights.append((f"{w} {fit}", runs))
+    lines += [*table(weights), ""]
+    atomic_write_text(args.out, "\n".join(lines))
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
