@@ -126,6 +126,11 @@ def prepare(cfg: DictConfig) -> Prepared:
     device = pick_device(cfg.trainer.device)
     graph: GraphSpec = instantiate(cfg.graph)  # a bad config value is named before any data
     sensing = instantiate(cfg.sensing)
+    if cfg.model.get("coupling_fit") == "motion" and cfg.trainer.get("placements"):
+        raise InputError(
+            "model.coupling_fit=motion fits one placement from the data; trainer.placements "
+            "gives each window its own: choose one"
+        )
     files = expand_paths(cfg.data.train)
     check_transfer(cfg, files)
     rec = load_recordings(files, pad=bool(cfg.get("transfer", False)))  # across joint counts
@@ -140,7 +145,7 @@ def prepare(cfg: DictConfig) -> Prepared:
         cfg.model, graph.adjacency, graph.num_joints, schema.N_FEATURES, int(cfg.window)
     ).to(device)
     head = getattr(model, "anomaly", None)
-    if head is not None and head.coupling_fit == "motion" and not cfg.trainer.get("placements"):
+    if head is not None and head.coupling_fit == "motion":
         head.set_coupling(training_placement(rec, splits["train"], graph))  # frozen from here
     pool = None
     if cfg.trainer.get("placements"):

@@ -319,3 +319,15 @@ def test_training_with_the_motion_fit_sets_the_placement_once_and_never_moves_it
     corr = coupling_correlation(trained, truth)
     assert corr > 0.5
     assert results["train"]["coupling_correlation"] == pytest.approx(corr, abs=1e-4)
+
+
+def test_a_motion_fit_under_drawn_placements_is_refused_before_any_data():
+    """One placement fitted from the data and a placement per window contradict each other."""
+    from robohealth_mj.learn.trainer import prepare
+
+    cfg = compose_config("train", [
+        "data.train=[/nonexistent/train_*]", "graph=harness", "variant=anomaly_residual",
+        "model.coupling_fit=motion", "trainer.placements=4",
+    ])  # fmt: skip
+    with pytest.raises(ValueError, match=r"coupling_fit=motion .* choose one"):
+        prepare(cfg)
