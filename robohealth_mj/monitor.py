@@ -20,6 +20,7 @@ from omegaconf import DictConfig
 
 from robohealth_mj.common.config import run_tool
 from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.common.threads import resolve_threads
 from robohealth_mj.runtime.monitor import monitor_policies, monitor_stream
 from robohealth_mj.runtime.ready import resolve_file, resolve_model
 from robohealth_mj.runtime.runtime import ModelRuntime
@@ -38,7 +39,7 @@ def run(cfg: DictConfig) -> dict | None:
         alarm, evidence, contact = monitor_policies(cfg)
         runtime = ModelRuntime(
             cfg.model,
-            threads=cfg.threads,
+            threads=resolve_threads(cfg.threads, "threads"),
             alarm=alarm,
             incremental=cfg.incremental,
             evidence=evidence,

@@ -23,6 +23,7 @@ from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.config import placement_name
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.threads import resolve_threads, use_torch_threads
 from robohealth_mj.common.version import code_version
 from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.data.graphs import GraphSpec, coupling_correlation
@@ -121,8 +122,7 @@ class Prepared:
 
 def prepare(cfg: DictConfig) -> Prepared:
     seed_everything(int(cfg.seed))
-    if cfg.trainer.get("threads"):
-        torch.set_num_threads(int(cfg.trainer.threads))
+    use_torch_threads(resolve_threads(cfg.get("threads"), "threads"))
     device = pick_device(cfg.trainer.device)
     graph: GraphSpec = instantiate(cfg.graph)  # a bad config value is named before any data
     sensing = instantiate(cfg.sensing)
@@ -328,7 +328,7 @@ def fit_trees(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
         tree_table(p, p.splits["train"]),
         tree_table(p, p.splits["val"]),
         seed=int(p.cfg.seed),
-        threads=p.cfg.trainer.get("threads"),
+        threads=torch.get_num_threads(),  # the one count prepare() resolved
     )
     val_m = metrics_of(predict(p.model, p.tensors, p.splits["val"]))
     row = {

@@ -36,15 +36,62 @@ def window_attribution(
     )
 
 
+def mode_attribution(
+    class_logits: np.ndarray, joint_logits: np.ndarray, severity: np.ndarray | None
+) -> np.ndarray:
+    """``[K, M, J]``: :func:`window_attribution` split by mechanical mode
+    (``MECHANICAL_CLASSES``); summed over M it is the window's attribution."""
+    return mode_probabilities(
+        softmax(np.asarray(class_logits, np.float64)),
+        softmax(np.asarray(joint_logits, np.float64)),
+        severity,
+    )
+
+
+def mode_probabilities(
+    p_class: np.ndarray, p_joint: np.ndarray, severity: np.ndarray | None = None
+) -> np.ndarray:
+    """:func:`mode_attribution` from probabilities (``[K, C]`` over ``FAULT_CLASSES``,
+    ``[K, J]``), as the runtime's diagnoses carry them."""
+    p_class = np.asarray(p_class, np.float64)
+    mech = p_class[:, [FAULT_CLASSES.index(c) for c in MECHANICAL_CLASSES]]
+    sev = np.ones(len(mech)) if severity is None else np.clip(np.asarray(severity), 0.0, 1.0)
+    return (mech * sev[:, None])[:, :, None] * np.asarray(p_joint, np.float64)[:, None, :]
+
+
 def attribution_from_probabilities(
     p_class: np.ndarray, p_joint: np.ndarray, severity: np.ndarray | None = None
 ) -> np.ndarray:
     """:func:`window_attribution` from probabilities (``[K, C]`` over ``FAULT_CLASSES``,
     ``[K, J]``), as the runtime's diagnoses carry them."""
-    mech = [FAULT_CLASSES.index(c) for c in MECHANICAL_CLASSES]
-    p_mech = np.asarray(p_class, np.float64)[:, mech].sum(axis=1)
-    sev = np.ones(len(p_mech)) if severity is None else np.clip(np.asarray(severity), 0.0, 1.0)
-    return (p_mech * sev)[:, None] * np.asarray(p_joint, np.float64)
+    return mode_probabilities(p_class, p_joint, severity).sum(axis=1)
+
+
+def isotonic(values: np.ndarray) -> np.ndarray:
+    """The non-decreasing sequence nearest ``values [S]`` in least squares (pool adjacent
+    violators)."""
+    level: list[float] = []
+    weight: list[int] = []
+    for value in np.asarray(values, float):
+        level.append(float(value))
+        weight.append(1)
+        while len(level) > 1 and level[-2] > level[-1]:
+            w = weight[-2] + weight[-1]
+            level[-2] = (level[-2] * weight[-2] + level[-1] * weight[-1]) / w
+            weight[-2] = w
+            level.pop(), weight.pop()
+    return np.repeat(level, weight)
+
+
+def monotone_index(history: np.ndarray) -> np.ndarray:
+    """A joint's daily index ``[S]`` (oldest first) read as wear, which never heals: the
+    non-decreasing fit of the days so far. Missing days (NaN) are left out of the fit and keep
+    NaN. A monitor reads the last value; replayed day by day it gives each day's reading."""
+    h = np.asarray(history, float)
+    out = np.full(h.shape, np.nan)
+    keep = np.isfinite(h)
+    out[keep] = isotonic(h[keep])
+    return out
 
 
 @dataclass
@@ -77,17 +124,7 @@ class Calibration:
         most ``knots`` points at the raw index's quantiles."""
         order = np.argsort(raw, kind="stable")
         xs, ys = np.asarray(raw, float)[order], np.asarray(truth, float)[order]
-        level, weight, start = [], [], []
-        for i, value in enumerate(ys):  # pool adjacent violators
-            level.append(value)
-            weight.append(1.0)
-            start.append(i)
-            while len(level) > 1 and level[-2] > level[-1]:
-                w = weight[-2] + weight[-1]
-                level[-2] = (level[-2] * weight[-2] + level[-1] * weight[-1]) / w
-                weight[-2] = w
-                level.pop(), weight.pop(), start.pop()
-        fitted = np.repeat(level, np.asarray(weight, int))
+        fitted = isotonic(ys)
         picks = np.unique(np.linspace(0, len(xs) - 1, knots).round().astype(int))
         kx, ky = xs[picks], fitted[picks]
         keep = np.concatenate([[True], np.diff(kx) > 0])

@@ -34,6 +34,7 @@ from robohealth_mj import schema
 from robohealth_mj.arms.description import DEFAULT_ARM
 from robohealth_mj.common.errors import USER_ERRORS, InputError
 from robohealth_mj.common.numeric import joint_scores_from_logits, softmax
+from robohealth_mj.common.threads import onnx_session_options
 from robohealth_mj.data.observability import MOVING_RAD_S, check_observability, hide_unobservable
 from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
@@ -231,8 +232,7 @@ class FleetRuntime:
 
         meta = read_metadata(path)  # checks the schema version and the arm graph
         self.graph = meta["arm_graph"]
-        options = ort.SessionOptions()
-        options.intra_op_num_threads = threads
+        options = onnx_session_options(threads)
         # named providers were checked in __init__; else CUDA where present, else the CPU
         wanted = list(providers or execution_providers(None, ort.get_available_providers()))
         if "CUDAExecutionProvider" in wanted and hasattr(ort, "preload_dlls"):

@@ -1,6 +1,8 @@
 """Health across sessions: each arm's per-joint index history, its RUL and the wear warning,
 persisted per arm so that a restarted monitor carries on where it stopped.
 
+The history keeps each session's calibrated index as it was read; with ``monotone`` the joints'
+estimates read it as wear that never heals (its non-decreasing fit), as the wear study chose.
 A session ends -> :meth:`HealthTracker.update` with the session's :class:`SessionHealth` and its
 operating day -> the history grows, the state file is rewritten atomically, and the joints' RUL
 estimates and warnings come back (and as ``/diagnostics`` key/values, :func:`health_fields`).
@@ -19,7 +21,7 @@ import numpy as np
 
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.prognostics.health import SessionHealth
+from robohealth_mj.prognostics.health import SessionHealth, monotone_index
 from robohealth_mj.prognostics.rul import RulEstimate, TrendRul
 from robohealth_mj.schema import JOINT_NAMES
 
@@ -44,6 +46,7 @@ class HealthTracker:
     estimator: TrendRul = field(default_factory=TrendRul)
     lead_days: float = 10.0
     floor: float = 0.15
+    monotone: bool = False  # read each joint's history as wear that never heals (index_model.py)
 
     def _path(self, arm: str) -> Path:
         if not arm or any(c in arm for c in "/\\") or arm.startswith("."):
@@ -100,12 +103,13 @@ class HealthTracker:
         index = np.array([s["index"] for s in sessions], float)  # [S, J]
         out = []
         for j, name in enumerate(state.get("joints", JOINT_NAMES)):
-            rul = self.estimator.estimate(days, index[:, j])
+            seen = monotone_index(index[:, j]) if self.monotone else index[:, j]
+            rul = self.estimator.estimate(days, seen)
             last = sessions[-1]
             out.append(
                 JointHealth(
                     name,
-                    last["index"][j],
+                    float(seen[-1]),
                     last["low"][j],
                     last["high"][j],
                     rul,

@@ -7,6 +7,7 @@ replayed stream is pulled through it here; live arms on the bus push into it
 from __future__ import annotations
 
 import time
+from collections import deque
 from collections.abc import Iterator
 from contextlib import ExitStack
 from datetime import datetime
@@ -19,13 +20,16 @@ from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.bags.writer import BagWriter
 from robohealth_mj.common.atomic import atomic_write_json, atomic_write_text
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.data.observability import MOVING_RAD_S
 from robohealth_mj.data.read import open_recording
 from robohealth_mj.data.sensing import refuse_missing_channels
+from robohealth_mj.prognostics.channels import ChannelSums
 from robohealth_mj.prognostics.health import (
-    Calibration,
     attribution_from_probabilities,
+    mode_probabilities,
     session_health,
 )
+from robohealth_mj.prognostics.index_model import FittedIndex, session_reading
 from robohealth_mj.prognostics.rul import TrendRul
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.contact import ContactPolicy
@@ -149,7 +153,8 @@ class MonitorSession:
         health = cfg.get("health", {})
         self.health = health if health.get("state_dir") else None
         if self.health is not None and cfg.source != "ros2":
-            self.wear[cfg.stream_id] = SessionWear(cfg.stream_id, self.health)  # refused early
+            # a bad health block is refused before the session
+            self.wear[cfg.stream_id] = SessionWear(cfg.stream_id, self.health, runtime.window)
         self._stack = ExitStack()
         self.bag = self._stack.enter_context(BagWriter(cfg.bag_out)) if cfg.get("bag_out") else None
 
@@ -164,6 +169,8 @@ class MonitorSession:
     ) -> None:
         """One diagnosis of ``stream_id``'s sample (``truth``: its fault label, None unknown)."""
         fleet = self.runtime.fleet
+        wanted = self.health is not None or (self.cfg.evaluate and truth is not None)
+        activity = joint_activity(sample.x) if wanted and isinstance(sample, GraphSample) else ()
         if self.bag is not None and isinstance(sample, GraphSample):
             self.bag.write_sample(sample)
             self.bag.write_diagnosis(d, fleet.classes, fleet.joints)
@@ -172,15 +179,15 @@ class MonitorSession:
                 self.evaluators[stream_id] = OnlineEvaluator(
                     settle_ticks=self.settle, arm=self.runtime.arm
                 )
-            activity = joint_activity(sample.x) if isinstance(sample, GraphSample) else ()
             self.evaluators[stream_id].update(truth, d, *activity)
         if self.print_changes:
             shown = truth if self.labelled else None
             self.last[stream_id] = print_change(stream_id, t, d, shown, self.last.get(stream_id))
         if self.health is not None:
             if stream_id not in self.wear:
-                self.wear[stream_id] = SessionWear(stream_id, self.health)
-            self.wear[stream_id].add(d, fleet.joints)
+                self.wear[stream_id] = SessionWear(stream_id, self.health, self.runtime.window)
+            x = sample.x if isinstance(sample, GraphSample) else None
+            self.wear[stream_id].add(d, fleet.joints, activity[0] if activity else None, x)
 
     def finish(self) -> dict | None:
         """Wear into each arm's history; the evaluation written (one stream: its figures; live
@@ -234,37 +241,69 @@ class SessionWear:
     """The session's decided windows, turned into the arm's health index when it ends and added
     to the arm's history (``health.state_dir``; :mod:`robohealth_mj.runtime.health`)."""
 
-    def __init__(self, stream_id: str, cfg: DictConfig) -> None:
+    def __init__(self, stream_id: str, cfg: DictConfig, window: int = 32) -> None:
+        """``window``: the model's, in snapshots (a window *moved* a joint if any of its
+        snapshots turned it, as :func:`robohealth_mj.data.windows.joints_moved` reads it)."""
         if cfg.get("day") is None:
             raise InputError("health.state_dir needs health.day: this session's operating day")
         cal = cfg.get("calibration")
-        self.calibration = Calibration.load(cal) if cal else None
+        self.index = FittedIndex.load(cal) if cal else None  # how the index is read (studies/wear)
         self.tracker = HealthTracker(
             Path(cfg.state_dir),
             TrendRul(threshold=float(cfg.threshold)),
             lead_days=float(cfg.lead_days),
             floor=float(cfg.floor),
+            monotone=bool(self.index and self.index.model.monotone),
         )
         self.tracker.history(stream_id)  # a broken state file is refused before the session
         self.stream_id, self.day = stream_id, float(cfg.day)
         self.probs: list[list[float]] = []
         self.joints: list[list[float]] = []
+        self.moved: list[np.ndarray] = []  # per decided window: each joint turned in it
+        self.speeds: deque[np.ndarray] = deque(maxlen=max(1, int(window)))
         self.names: list[str] = list(JOINT_NAMES)  # the model's joints (the arm's)
+        self.channels: ChannelSums | None = None  # the session's friction and backlash channels
 
-    def add(self, d: HealthDiagnosis, joints: list[str]) -> None:
+    def add(
+        self,
+        d: HealthDiagnosis,
+        joints: list[str],
+        speeds: np.ndarray | None = None,
+        x: np.ndarray | None = None,
+    ) -> None:
+        """One diagnosis; ``speeds [J]``: the joints' |velocity| in the sample that completed it,
+        ``x [N, F]`` the sample (its channels feed the friction and backlash readings)."""
         self.names = list(joints)
+        if speeds is not None and len(speeds) == len(joints):
+            self.speeds.append(np.asarray(speeds, float))
+        if x is not None:
+            if self.channels is None:
+                self.channels = ChannelSums(len(joints))
+            self.channels.add(x)
         if d.valid and d.fault_class is not None:
             self.probs.append([d.class_probabilities.get(c, 0.0) for c in FAULT_CLASSES])
             self.joints.append([d.joint_scores[j] for j in joints])
+            turned = np.max(self.speeds, axis=0) if self.speeds else np.zeros(len(joints))
+            self.moved.append(turned > MOVING_RAD_S)
 
     def finish(self) -> list:
-        attribution = attribution_from_probabilities(
-            np.array(self.probs).reshape(-1, len(FAULT_CLASSES)),
-            np.array(self.joints).reshape(-1, len(self.names)),
-        )
-        health = session_health(attribution, self.calibration)
+        p_class = np.array(self.probs).reshape(-1, len(FAULT_CLASSES))
+        p_joint = np.array(self.joints).reshape(-1, len(self.names))
+        health = session_health(attribution_from_probabilities(p_class, p_joint))
         if health.windows == 0:
             raise InputError(f"{self.stream_id}: no decided window this session: no health index")
+        if self.index is not None:  # the calibrated reading; the band mapped as the pooled map
+            day = {"raw": health.raw, **session_reading(
+                mode_probabilities(p_class, p_joint), np.array(self.moved).reshape(p_joint.shape)
+            )}  # fmt: skip
+            if self.channels is not None:
+                day["channel"] = self.channels.readings()
+            elif self.index.model.raw == "channel":
+                raise InputError(f"{self.stream_id}: the index reads the joints' channels, and "
+                                 "this source gave none")  # fmt: skip
+            health.index = self.index.calibrate(day)
+            health.low = np.minimum(self.index.pooled(health.low), health.index)
+            health.high = np.maximum(self.index.pooled(health.high), health.index)
         joints = self.tracker.update(self.stream_id, self.day, health, self.names)
         fields = dict(health_fields(joints))
         for j in joints:

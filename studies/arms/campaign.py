@@ -57,7 +57,7 @@ def train(sweep: Path, train: list[str], heldout: Path, args: argparse.Namespace
         f"data.evaluate.heldout={heldout}",
         "data.evaluate.probe=null",
         f"trainer.epochs={args.epochs}",
-        "trainer.threads=1",
+        "threads=1",
         "trainer.progress=false",
         "hydra/launcher=local",
         f"hydra.sweep.dir={sweep}",

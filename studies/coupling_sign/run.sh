@@ -24,7 +24,7 @@ HERE=studies/coupling_sign
 run() {  # out_dir, then overrides: one training run of one thread
   local out=$1; shift
   $PY -m robohealth_mj.train graph=harness window=32 model.anomaly_scores=energy \
-    trainer.threads=1 trainer.progress=false "data.train=[$CORPUS/train_*]" \
+    threads=1 trainer.progress=false "data.train=[$CORPUS/train_*]" \
     data.evaluate.heldout="$CORPUS/heldout_seed900" '~data.evaluate.probe' \
     out_dir="$ROOT/$out" "$@" >"$ROOT/logs/${out//\//_}.log" 2>&1 || echo "failed: $out" >&2
 }

@@ -12,5 +12,5 @@ print('caches built')
 "
 python -m robohealth_mj.train -m variant=mlp,stgnn_fixed,anomaly_residual graph=structural,harness \
   seed=42 window=16 trainer.epochs=10 trainer.max_windows_per_epoch=15000 trainer.progress=false \
-  trainer.threads=1 hydra/launcher=local hydra.sweep.dir=outputs/campaign_cpu
+  threads=1 hydra/launcher=local hydra.sweep.dir=outputs/campaign_cpu
 python -m robohealth_mj.report outputs/campaign_cpu

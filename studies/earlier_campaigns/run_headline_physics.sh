@@ -9,8 +9,8 @@
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
 $PY -m robohealth_mj.corpus                      # outputs/corpus/standard (physics), ~9 min
-C="+experiment=headline hydra.sweep.dir=outputs/campaign_physics trainer.threads=1 trainer.progress=false"
-T="trainer.threads=1 trainer.progress=false"
+C="+experiment=headline hydra.sweep.dir=outputs/campaign_physics threads=1 trainer.progress=false"
+T="threads=1 trainer.progress=false"
 (
   $PY -m robohealth_mj.train -m $C variant=gbdt seed=42,43,44
   $PY -m robohealth_mj.train variant=gbdt seed=42 $T out_dir=outputs/ablation_physics/gbdt_v1_channels \

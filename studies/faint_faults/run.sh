@@ -22,7 +22,7 @@ done
 $PY -m robohealth_mj.corpus progress=false
 $PY -m robohealth_mj.train variant=anomaly_residual seed=42 window=32 trainer.epochs=30 trainer.patience=30 \
   trainer.progress=false out_dir=outputs/faint_faults/anomaly_residual_w32_seed42
-$PY -m robohealth_mj.train variant=gbdt seed=42 window=32 trainer.threads=1 trainer.progress=false \
+$PY -m robohealth_mj.train variant=gbdt seed=42 window=32 threads=1 trainer.progress=false \
   out_dir=outputs/faint_faults/gbdt_w32_seed42
 $PY -m robohealth_mj.export ckpt=outputs/faint_faults/anomaly_residual_w32_seed42/best.ckpt out=$NEW
 

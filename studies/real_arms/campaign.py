@@ -374,7 +374,7 @@ def main() -> None:
         run_step("robohealth_mj.train", "-m", f"variant={args.variants}", f"seed={args.seed}",
                  "sensing=stock_reduced", "window=32", f"data.train=[{train}]",
                  f"data.evaluate.heldout={corpora[-1]}/heldout_seed900", "data.evaluate.probe=null",
-                 f"trainer.epochs={args.epochs}", f"labels={args.labels}", "trainer.threads=1",
+                 f"trainer.epochs={args.epochs}", f"labels={args.labels}", "threads=1",
                  "trainer.progress=false",
                  "hydra/launcher=local", f"hydra.sweep.dir={sweep}")  # fmt: skip
     commissioning = [p for role in COMMISSION[args.commission] for p in LOGS_ROLES[role]]

@@ -26,7 +26,7 @@ $PY -m robohealth_mj.record seed=940 faults=none session.duration_s=600 session.
 H="graph=harness sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy window=32"
 D="data.train=[$CORPUS/train_*] data.evaluate.heldout=$CORPUS/heldout_seed900"
 P="$H $D data.evaluate.probe=null trainer.placements=256 trainer.epochs=40 trainer.patience=8"
-P="$P trainer.threads=1"
+P="$P threads=1"
 S=outputs/selfcal
 # The pool model's design (pool_design.md): the earlier dense-edge model, then the placement told
 # to message passing, the head's joint scores and the sensor nodes, alone and together; the
@@ -41,9 +41,9 @@ S=outputs/selfcal
   $PY -m robohealth_mj.train $P model.anomaly_joint_scores=true model.placement_embedding=true \
     out_dir=$S/pool256_e40_joint_placed
   $PY -m robohealth_mj.train +experiment=self_calibrating sensing=retrofit $D \
-    data.evaluate.probe=null trainer.threads=1 out_dir=$S/pool256_e40_edges_joint_placed
+    data.evaluate.probe=null threads=1 out_dir=$S/pool256_e40_edges_joint_placed
   $PY -m robohealth_mj.train +experiment=self_calibrating sensing=retrofit $D \
-    data.evaluate.probe=null trainer.threads=1 trainer.placement_noise=0.3 \
+    data.evaluate.probe=null threads=1 trainer.placement_noise=0.3 \
     out_dir=$S/pool256_e40_edges_joint_placed_noise03
 }
 CORPUS=$CORPUS THREADS=2 $PY studies/stock_arm/pool_design.py dense=$S/pool256_e40/best.ckpt \
@@ -54,7 +54,7 @@ CORPUS=$CORPUS THREADS=2 $PY studies/stock_arm/pool_design.py dense=$S/pool256_e
   edges+joint_scores+placement_embedding+noise_0.3=$S/pool256_e40_edges_joint_placed_noise03/best.ckpt \
   > studies/stock_arm/results/pool_design.md
 # shellcheck disable=SC2086
-$PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs=2 trainer.threads=1 \
+$PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs=2 threads=1 \
   hydra.sweep.dir=outputs/thesis_physics $D data.evaluate.probe=$CORPUS/probe_payload_high_seed901 \
   +experiment=placements sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy \
   graph.coupling_sensors=4 graph.coupling_seed=2,5,21,22,23
@@ -66,9 +66,9 @@ CORPUS=$CORPUS $PY studies/stock_arm/self_calibration.py $S/pool256_e40/best.ckp
 # A second seed of the chosen pool model and of the trained-on-placement references.
 # shellcheck disable=SC2086
 $PY -m robohealth_mj.train +experiment=self_calibrating sensing=retrofit $D seed=43 \
-  data.evaluate.probe=null trainer.threads=1 out_dir=$S/self_calibrating_seed43
+  data.evaluate.probe=null threads=1 out_dir=$S/self_calibrating_seed43
 # shellcheck disable=SC2086
-$PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs=2 trainer.threads=1 \
+$PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs=2 threads=1 \
   hydra.sweep.dir=outputs/thesis_physics $D data.evaluate.probe=$CORPUS/probe_payload_high_seed901 \
   +experiment=placements sensing=retrofit variant=anomaly_residual model.anomaly_scores=energy \
   graph.coupling_sensors=4 graph.coupling_seed=2,5,21,22,23 seed=43
@@ -80,7 +80,7 @@ CORPUS=$CORPUS $PY studies/stock_arm/self_calibration.py $S/self_calibrating_see
 CORPUS=$CORPUS $PY studies/stock_arm/self_calibration_retrain.py estimate outputs/selfcal/pool256_e40/best.ckpt
 for s in 2 5 21 22 23; do
   # shellcheck disable=SC2086
-  $PY -m robohealth_mj.train sensing=retrofit trainer.threads=1 $D data.evaluate.probe=null \
+  $PY -m robohealth_mj.train sensing=retrofit threads=1 $D data.evaluate.probe=null \
     +experiment=placements variant=anomaly_residual model.anomaly_scores=energy \
     graph.coupling_file=outputs/selfcal/estimated/seed$s.json out_dir=outputs/selfcal/retrained/seed$s
 done

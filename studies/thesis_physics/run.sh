@@ -14,7 +14,7 @@ CORPUS=${CORPUS:-outputs/corpus/standard}
 EXTRA=(${TRAIN_ARGS:-})
 train() {
   $PY -m robohealth_mj.train -m hydra/launcher=local hydra.launcher.n_jobs="$JOBS" \
-    trainer.threads=1 trainer.progress=false hydra.sweep.dir="$ROOT" \
+    threads=1 trainer.progress=false hydra.sweep.dir="$ROOT" \
     "data.train=[$CORPUS/train_*]" data.evaluate.heldout="$CORPUS/heldout_seed900" \
     data.evaluate.probe="$CORPUS/probe_payload_high_seed901" "${EXTRA[@]}" "$@"
 }

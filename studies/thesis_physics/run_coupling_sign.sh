@@ -7,7 +7,7 @@ PY=${PY:-.venv/bin/python}
 for seed in 42 43; do
   for sc in signed energy; do
     $PY -m robohealth_mj.train variant=anomaly_residual graph=harness seed=$seed window=32 \
-      model.anomaly_scores=$sc trainer.threads=1 trainer.progress=false '~data.evaluate.probe' \
+      model.anomaly_scores=$sc threads=1 trainer.progress=false '~data.evaluate.probe' \
       out_dir=outputs/coupling_sign/harness_${sc}_seed$seed &
   done
   wait

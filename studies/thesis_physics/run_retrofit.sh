@@ -6,6 +6,6 @@ set -euo pipefail
 PY=${PY:-.venv/bin/python}
 for v in anomaly_residual gbdt; do
   $PY -m robohealth_mj.train variant=$v graph=harness sensing=retrofit seed=42 window=32 \
-    trainer.threads=1 trainer.progress=false '~data.evaluate.probe' out_dir=outputs/retrofit/${v}_seed42 &
+    threads=1 trainer.progress=false '~data.evaluate.probe' out_dir=outputs/retrofit/${v}_seed42 &
 done
 wait

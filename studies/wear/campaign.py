@@ -1,18 +1,24 @@
-"""Wear over weeks (issue 39): a window model trained on lives, a health index per joint and
-session, and the RUL and wear warnings it gives on held-out lives.
+"""Wear over weeks (issues 39 and 68): a window model trained on lives, a health index per joint
+and day, and the warnings a maintenance planner is given on lives it never saw.
 
     python -m robohealth_mj.corpus corpus=lives            # outputs/corpus/lives
     python studies/wear/campaign.py [--variant gbdt] [--seed 42] [--labels last]
-        [--estimators trend,progpy] [--lead-days 10] [--floor 0.15]
+        [--train-also 'outputs/corpus/standard/train_*'] [--estimators trend,progpy]
 
 Steps (each skipped when done): train ``--variant`` on every day of the training lives
-(``outputs/lives/<run>/model``); score every day of every life (``health_raw.json``: the raw
-index per joint with its bootstrap band); fit the index's calibration on the days the model's
-validation split holds (never on a held-out life); tune the warning's lead time and floor on the
-validation lives (lives the model never trained on); then per held-out life the index against the
-truth, each estimator's RUL day by day on the wearing joint (prognostic horizon, alpha-lambda,
-relative accuracy at half-life) and the first warning; warnings on healthy arm-days.
-``lives.json`` holds every number; ``studies/wear/summarise.py`` writes the tables.
+(``outputs/lives/<run>/model``); score every day of every life (``health_raw.json``: per joint the
+raw index, its bootstrap band, the index split by mechanical mode and over only the windows in
+which the joint turned). Then for each way of reading the index
+(``robohealth_mj/prognostics/index_model.py``): fit its calibration on the training lives' days in
+the model's validation split and the validation lives (each validation life read through the maps
+fitted without it), tune the warning's lead time and floor on the validation lives, and replay
+every life day by day as the monitor runs it,
+on every joint: the index against the truth (on the wearing joint, and how high the others read),
+each wearing life's first warning on any joint judged against the 5-20 day band (``in_band``,
+``early``, ``late``, ``wrong_joint``, ``missed``), and warnings per 100 healthy arm-days. The index
+model is chosen on the validation lives; the held-out lives (the corpus's) and the fresh lives
+(seeds no choice ever saw) are reported. ``lives.json`` holds every number;
+``studies/wear/summarise.py`` writes the tables.
 """
 
 from __future__ import annotations
@@ -21,24 +27,52 @@ import argparse
 import json
 import math
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import torch
+from tqdm import tqdm
 
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.steps import run_step
+from robohealth_mj.data.arrays import CACHE_SUFFIX
+from robohealth_mj.data.windows import joints_moved
 from robohealth_mj.learn.evaluation import score_checkpoint
 from robohealth_mj.learn.trainer import CHECKPOINT
 from robohealth_mj.prognostics import metrics
-from robohealth_mj.prognostics.health import Calibration, session_health, window_attribution
+from robohealth_mj.prognostics.channels import channel_readings, fit_scales
+from robohealth_mj.prognostics.health import mode_attribution, session_health, window_attribution
+from robohealth_mj.prognostics.index_model import (
+    VARIANTS,
+    FittedIndex,
+    IndexModel,
+    fit_index,
+    session_reading,
+)
+from robohealth_mj.prognostics.planner import (
+    DEFAULT_BAND,
+    Replay,
+    first_warning,
+    outcome_shares,
+    replay_estimates,
+)
 from robohealth_mj.prognostics.rul import TrendRul
 from robohealth_mj.schema import JOINT_NAMES
 
 CORPUS = Path("outputs/corpus/lives")
 OUT = Path("outputs/lives")
 HELD_OUT, TRAIN, HEALTHY = "heldout_lives", "train_lives", "healthy_lives"
-VAL = "val_lives"  # never trained on: the warning's lead time and floor are tuned here
+CACHE = "graphs.jsonl" + CACHE_SUFFIX  # a recording's binary cache
+VAL, VAL_WIDE = "val_lives", "val_wide_lives"  # never trained on: where the index is calibrated
+# and the index model and the warning chosen (val_wide_lives drawn as the held-out lives are)
+FRESH, FRESH_HEALTHY = "fresh_lives", "fresh_healthy_lives"  # seeds no choice ever saw
+ROLES = (TRAIN, VAL, VAL_WIDE, HELD_OUT, HEALTHY, FRESH, FRESH_HEALTHY)
+GROUPS = {
+    "validation": (VAL, VAL_WIDE),
+    "held_out": (HELD_OUT, HEALTHY),
+    "fresh": (FRESH, FRESH_HEALTHY),
+}
 
 
 def train(
@@ -78,21 +112,24 @@ def score_lives(ckpt: Path, index: dict, run_dir: Path) -> dict:
     such as a role added to the corpus later, is scored and added)."""
     cache = run_dir / "health_raw.json"
     out = json.loads(cache.read_text()) if cache.is_file() else {}
-    todo = [(role, entry) for role in (TRAIN, VAL, HELD_OUT, HEALTHY)
-            for entry in index["roles"].get(role, []) if entry["dir"] not in out]  # fmt: skip
+    todo = [(role, entry) for role in ROLES for entry in index["roles"].get(role, [])
+            if "raw_moving" not in out.get(entry["dir"], {}).get("days", [{}])[0]]  # fmt: skip
     if not todo:
         return out
-    for role, entry in todo:
+    for role, entry in tqdm(todo, desc="scoring lives", unit="life", disable=None):
         life = json.loads((CORPUS / entry["life"]).read_text())
         sessions = [CORPUS / entry["dir"] / d["dir"] for d in life["days"]]
         scored = score_checkpoint(ckpt, [str(s) for s in sessions], device="cpu")
         p = scored.predictions
         attribution = window_attribution(p.class_logits, p.joint_logits, p.severity)
+        by_mode = mode_attribution(p.class_logits, p.joint_logits, p.severity)  # [K, M, J]
+        moved = joints_moved(scored.rec, scored.windows)  # [K, J]
         run_of = np.asarray(scored.rec.run_ids)[scored.rec.run[scored.windows.end]]
         days = []
         for d, session in zip(life["days"], sessions, strict=True):
             rid = _manifest_run_id(session)
-            h = session_health(attribution[run_of == rid], seed=d["day"])
+            mine = run_of == rid
+            h = session_health(attribution[mine], seed=d["day"])
             days.append(
                 {
                     "day": d["day"],
@@ -101,6 +138,8 @@ def score_lives(ckpt: Path, index: dict, run_dir: Path) -> dict:
                     "raw": h.raw.tolist(),
                     "low": h.low.tolist(),
                     "high": h.high.tolist(),
+                    **session_reading(by_mode[mine], moved[mine]),
+                    "moving_share": moved[mine].mean(axis=0).round(4).tolist(),
                 }
             )
         out[entry["dir"]] = {
@@ -116,162 +155,266 @@ def score_lives(ckpt: Path, index: dict, run_dir: Path) -> dict:
     return out
 
 
-def calibrate(ckpt: Path, scores: dict) -> tuple[Calibration, int]:
-    """Isotonic map raw -> severity on the training lives' days in the model's validation split."""
+def add_channels(scores: dict) -> None:
+    """Each day's friction and backlash channel readings per joint (the recording alone, no
+    model: :mod:`robohealth_mj.prognostics.channels`), added where the cache lacks them."""
+    for name, life in scores.items():
+        if all("channel" in d for d in life["days"]):
+            continue
+        for d in life["days"]:
+            x = np.load(CORPUS / name / f"day_{int(d['day']):03d}" / CACHE)["x"]
+            d["channel"] = np.round(channel_readings(x, len(JOINT_NAMES)), 8).tolist()
+
+
+def channel_scales(run_dir: Path, extra: list[str]) -> np.ndarray | None:
+    """The channels' reading per unit severity, fitted on the fault episodes of the training
+    data beside the lives (``--train-also``; None without it: no channel index models)."""
+    path = run_dir / "channel_scales.json"
+    if path.is_file():
+        return np.array(json.loads(path.read_text()))
+    caches = sorted(p / CACHE for pattern in extra for p in Path().glob(pattern))
+    if not caches:
+        return None
+    scales = fit_scales([c for c in caches if c.is_file()], len(JOINT_NAMES))
+    atomic_write_json(path, np.round(scales, 8).tolist())
+    return scales
+
+
+def calibration_days(ckpt: Path, scores: dict) -> list[dict]:
+    """The training lives' days in the model's validation split: with the validation lives
+    (:func:`fitted_indexes`), what the index is calibrated on; never a held-out or fresh life."""
     val = set(torch.load(ckpt, map_location="cpu", weights_only=False)["split_runs"]["val"])
-    raw, truth = [], []
-    for life in scores.values():
-        if life["role"] != TRAIN:
-            continue
-        for d in life["days"]:
-            if d["run_id"] in val:
-                raw += d["raw"]
-                truth += d["truth"]
-    return Calibration.fit(np.array(raw), np.array(truth)), len(raw) // len(JOINT_NAMES)
+    return [d for life in scores.values() if life["role"] == TRAIN
+            for d in life["days"] if d["run_id"] in val]  # fmt: skip
 
 
-def health_table(scores: dict, cal: Calibration, role: str) -> dict:
-    err, err_wear, inside, n = [], [], [], 0
-    for life in scores.values():
-        if life["role"] != role:
+def lives_of(scores: dict, roles: tuple[str, ...]) -> list[dict]:
+    return [life for life in scores.values() if life["role"] in roles]
+
+
+@dataclass
+class LifeView:
+    """A life as one fitted index reads it: the daily index a monitor reports ``[S, J]`` and
+    every joint's trend estimate replayed day by day."""
+
+    life: dict
+    days: np.ndarray
+    truth: np.ndarray
+    seen: np.ndarray
+    replay: Replay
+
+
+def view(life: dict, index: FittedIndex, est: TrendRul) -> LifeView:
+    days = np.array([d["day"] for d in life["days"]], float)
+    daily = np.stack([index.calibrate(d) for d in life["days"]])
+    return LifeView(
+        life,
+        days,
+        np.array([d["truth"] for d in life["days"]]),
+        index.life(life["days"]),
+        replay_estimates(days, daily, est, index.online),
+    )
+
+
+def index_figures(views: list[LifeView]) -> dict:
+    """The index a monitor reads each day against the truth: on the wearing joint, on the other
+    joints of wearing lives, and on healthy lives."""
+    wear, others, healthy, per_life = [], [], [], []
+    for v in views:
+        life, err = v.life, np.abs(v.seen - v.truth)
+        if not life["joint"]:
+            healthy += v.seen.ravel().tolist()
             continue
-        for d in life["days"]:
-            hi, lo, up = cal(np.array(d["raw"])), cal(np.array(d["low"])), cal(np.array(d["high"]))
-            t = np.array(d["truth"])
-            err.append(np.abs(hi - t))
-            inside.append((lo - 0.02 <= t) & (t <= up + 0.02))
-            if life["joint"]:
-                j = JOINT_NAMES.index(life["joint"])
-                err_wear.append(abs(hi[j] - t[j]))
-            n += 1
+        j = JOINT_NAMES.index(life["joint"])
+        wear += err[:, j].tolist()
+        others += np.delete(v.seen, j, axis=1).ravel().tolist()
+        per_life.append(
+            {
+                "life": life["name"],
+                "mode": life["mode"],
+                "joint": life["joint"],
+                "path": life["path"],
+                "mae": float(err[:, j].mean()),
+                "final_truth": float(v.truth[-1, j]),
+                "final_index": float(v.seen[-1, j]),
+            }
+        )
+    mean = lambda v: float(np.mean(v)) if v else math.nan  # noqa: E731
     return {
-        "sessions": n,
-        "index_mae_all_joints": float(np.mean(err)) if err else math.nan,
-        "index_mae_wearing_joint": float(np.mean(err_wear)) if err_wear else math.nan,
-        "band_coverage_0.02": float(np.mean(inside)) if inside else math.nan,
+        "wearing_joint_mae": mean(wear),
+        "other_joints_mean_reading": mean(others),
+        "other_joints_p95_reading": float(np.quantile(others, 0.95)) if others else math.nan,
+        "healthy_lives_mean_reading": mean(healthy),
+        "days_on_wearing_joint": len(wear),
+        "per_life": per_life,
     }
 
 
-def life_curves(life: dict, cal: Calibration) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    days = np.array([d["day"] for d in life["days"]], float)
-    index = cal(np.array([d["raw"] for d in life["days"]]))  # [S, J]
-    truth = np.array([d["truth"] for d in life["days"]])
-    return days, index, truth
+def warning_figures(views: list[LifeView], lead: float, floor: float, band=DEFAULT_BAND) -> dict:
+    """Each wearing life's first warning on any joint, classified (:mod:`planner`), and the
+    warnings on healthy arm-days (healthy lives, and wearing lives' days before onset)."""
+    firsts, per_life, healthy_days, warned_days = [], [], 0, 0
+    for v in views:
+        life = v.life
+        warned = v.replay.warned(lead, floor)
+        before_onset = ~v.truth.any(axis=1)
+        healthy_days += int(before_onset.sum())
+        warned_days += int((warned.any(axis=1) & before_onset).sum())
+        if life["joint"] and life["failure_day"] is not None:
+            wearing = JOINT_NAMES.index(life["joint"])
+            first = first_warning(v.days, warned, wearing, life["failure_day"], band)
+            firsts.append(first)
+            per_life.append({"life": life["name"], "mode": life["mode"], "joint": life["joint"],
+                             "path": life["path"], "failure_day": life["failure_day"],
+                             **vars(first)})  # fmt: skip
+    return {
+        "lives": len(firsts),
+        **outcome_shares(firsts),
+        "healthy_arm_days": healthy_days,
+        "warned_healthy_days": warned_days,
+        "warnings_per_100_healthy_days": 100 * warned_days / max(healthy_days, 1),
+        "per_life": per_life,
+    }
 
 
-def rul_rows(scores: dict, cal: Calibration, estimators: dict, lead: float, floor: float) -> list:
-    """Per held-out life and estimator: RUL day by day on the wearing joint, the metrics, the
-    first warning (any joint) and whether it named the wearing joint."""
+LEADS = (4.0, 6.0, 8.0, 10.0, 12.0, 15.0, 20.0, 25.0, 30.0)
+FLOORS = (0.0, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5)
+
+
+def tune_warning(views: list[LifeView], band=DEFAULT_BAND) -> dict:
+    """Lead time and floor chosen on the validation lives: the most lives first warned inside
+    the band on the right joint, then the fewest healthy-day warnings, then the fewest early
+    warnings; among settings tied on all three, the middle lead time, then the middle floor (so
+    that a tie does not put the pick at a grid's edge). ``at_edge`` says if the pick is there."""
+    scored = []
+    for lead in LEADS:
+        for floor in FLOORS:
+            f = warning_figures(views, lead, floor, band)
+            key = (round(f["in_band"], 6), -round(f["warnings_per_100_healthy_days"], 6),
+                   -round(f["early"], 6))  # fmt: skip
+            scored.append((key, lead, floor))
+    best = max(k for k, *_ in scored)
+    tied = [(lead, floor) for k, lead, floor in scored if k == best]
+    leads = sorted({lead for lead, _ in tied})
+    lead = leads[len(leads) // 2]
+    floors = sorted(floor for tied_lead, floor in tied if tied_lead == lead)
+    floor = floors[len(floors) // 2]
+    return {
+        "lead_days": lead,
+        "floor": floor,
+        "in_band": best[0],
+        "tied_settings": len(tied),
+        "at_edge": lead in (LEADS[0], LEADS[-1]) or floor in (FLOORS[0], FLOORS[-1]),
+    }
+
+
+def fitted_indexes(
+    model: IndexModel, scores: dict, cal_days: list[dict], scales: np.ndarray | None
+) -> dict[str, FittedIndex]:
+    """The index each life is read through. Maps are fitted on the training lives' validation
+    days and the validation lives; a validation life is read through the maps fitted without it
+    (leave one life out), so that the choices made on the validation lives see out-of-sample
+    readings; every other life through the maps fitted on all of them."""
+    val = lives_of(scores, GROUPS["validation"])
+    full = fit_index(model, cal_days + [d for life in val for d in life["days"]], scales)
+    out = {name: full for name in scores}
+    for life in val:
+        others = [d for other in val if other is not life for d in other["days"]]
+        out[life["name"]] = fit_index(model, cal_days + others, scales)
+    out["_all"] = full
+    return out
+
+
+def evaluate_variant(
+    model: IndexModel,
+    scores: dict,
+    cal_days: list[dict],
+    est: TrendRul,
+    scales: np.ndarray | None = None,
+) -> dict:
+    """Fit, tune on the validation lives, report on every group of lives."""
+    indexes = fitted_indexes(model, scores, cal_days, scales)
+    views = {name: [view(life, indexes[life["name"]], est) for life in lives_of(scores, roles)]
+             for name, roles in GROUPS.items()}  # fmt: skip
+    tuned = tune_warning(views["validation"])
+    lead, floor = tuned["lead_days"], tuned["floor"]
+    return {
+        "index_model": model.name,
+        "warning": tuned,
+        "groups": {
+            name: {"index": index_figures(v), "warnings": warning_figures(v, lead, floor)}
+            for name, v in views.items()
+        },
+        "_index": indexes["_all"],
+    }
+
+
+def selection_key(row: dict) -> tuple:
+    """Chosen on the validation lives: in band, then healthy warnings, then wearing-joint MAE."""
+    v = row["groups"]["validation"]
+    return (round(v["warnings"]["in_band"], 6),
+            -round(v["warnings"]["warnings_per_100_healthy_days"], 6),
+            -v["index"]["wearing_joint_mae"])  # fmt: skip
+
+
+def rul_rows(
+    lives: list[dict], index: FittedIndex, estimators: dict, group: str, first: dict
+) -> list:
+    """Per wearing life and estimator: the RUL day by day on the wearing joint, the Saxena
+    metrics (prognostic horizon, alpha-lambda, relative accuracy at half-life), the index with
+    its band and the day of the life's first warning (``first``: per life, from
+    :func:`warning_figures`), as ``python -m robohealth_mj.report --lives`` draws them."""
     rows = []
-    for name, life in scores.items():
-        if life["role"] != HELD_OUT or life["failure_day"] is None:
+    for life in lives:
+        if not life["joint"] or life["failure_day"] is None:
             continue
-        days, index, truth = life_curves(life, cal)
+        days = np.array([d["day"] for d in life["days"]], float)
         j = JOINT_NAMES.index(life["joint"])
-        low = cal(np.array([d["low"][j] for d in life["days"]]))
-        high = cal(np.array([d["high"][j] for d in life["days"]]))
-        eol = float(life["failure_day"])
-        onset = float(days[np.argmax(truth[:, j] > 0)])
+        daily = np.stack([index.calibrate(d) for d in life["days"]])[:, j]
+        seen = index.life(life["days"])[:, j]
+        low = np.minimum(index.pooled(np.array([d["low"][j] for d in life["days"]])), seen)
+        high = np.maximum(index.pooled(np.array([d["high"][j] for d in life["days"]])), seen)
+        truth = np.array([d["truth"][j] for d in life["days"]])
+        eol, onset = float(life["failure_day"]), float(days[np.argmax(truth > 0)])
         for est_name, est in estimators.items():
             started = time.perf_counter()
-            estimates = [est.estimate(days[: k + 1], index[: k + 1, j]) for k in range(len(days))]
-            wall = time.perf_counter() - started
-            predicted = np.array([e.rul for e in estimates])
-            warn_day = next(
-                (days[k] for k, e in enumerate(estimates) if e.warns(lead, floor)), None
+            predicted = np.array(
+                [
+                    est.estimate(days[: k + 1], index.online(daily[: k + 1])).rul
+                    for k in range(len(days))
+                ]
             )
             rows.append(
                 {
-                    "life": name,
+                    "group": group,
+                    "life": life["name"],
                     "mode": life["mode"],
-                    "path": life["path"],
                     "joint": life["joint"],
+                    "path": life["path"],
                     "estimator": est_name,
                     "failure_day": eol,
                     "onset_day": onset,
                     "days": days.tolist(),
-                    "truth": truth[:, j].tolist(),
-                    "index": index[:, j].tolist(),
+                    "truth": truth.tolist(),
+                    "index": seen.tolist(),
                     "index_low": low.tolist(),
                     "index_high": high.tolist(),
+                    "first_warning_day": first[life["name"]]["day"],
+                    "first_warning_outcome": first[life["name"]]["outcome"],
                     "rul": [None if not math.isfinite(v) else v for v in predicted.tolist()],
-                    "rul_low": [e.low if math.isfinite(e.low) else None for e in estimates],
-                    "rul_high": [e.high if math.isfinite(e.high) else None for e in estimates],
                     "prognostic_horizon": metrics.prognostic_horizon(
                         days, predicted, eol, onset, 0.2
                     ),
                     "alpha_lambda_0.5": metrics.alpha_lambda(days, predicted, eol, onset, 0.2, 0.5),
                     "relative_accuracy_0.5": metrics.relative_accuracy(days, predicted, eol, onset),
-                    "first_warning_day": warn_day,
-                    "warning_lead_days": None if warn_day is None else eol - warn_day,
-                    "wall_s": wall,
+                    "wall_s": time.perf_counter() - started,
                 }
             )
     return rows
 
 
-def healthy_warnings(scores: dict, cal: Calibration, est: TrendRul, lead: float, floor: float):
-    """Warnings raised on healthy arm-days: every day of the healthy lives and every day of a
-    wearing life on which no joint had worn yet; a warning on a wearing life's other joints is
-    counted apart (wrong joint)."""
-    healthy_days = warned_days = wrong_joint = 0
-    for life in scores.values():
-        if life["role"] not in (HELD_OUT, HEALTHY):
-            continue
-        days, index, truth = life_curves(life, cal)
-        for k in range(len(days)):
-            warns = [
-                est.estimate(days[: k + 1], index[: k + 1, j]).warns(lead, floor)
-                for j in range(len(JOINT_NAMES))
-            ]
-            if not truth[k].any():
-                healthy_days += 1
-                warned_days += any(warns)
-            elif life["joint"]:
-                wear = JOINT_NAMES.index(life["joint"])
-                wrong_joint += any(w for j, w in enumerate(warns) if j != wear)
-    return {
-        "healthy_arm_days": healthy_days,
-        "warned_healthy_days": warned_days,
-        "warnings_per_100_healthy_days": 100 * warned_days / max(healthy_days, 1),
-        "wrong_joint_warning_days": wrong_joint,
-    }
-
-
-def warned_share(rows: list[dict], days: float = 5.0) -> float:
-    """The share of :func:`rul_rows`' lives first warned at least ``days`` before failure."""
-    return float(np.mean([(r["warning_lead_days"] or -1) >= days for r in rows]))
-
-
-def tuning_role(scores: dict) -> str:
-    """Where the warning is tuned: the validation lives where the corpus has them (the model
-    never trained on them), else the training lives (in-sample, so every setting tends to warn
-    every life in time)."""
-    return VAL if any(v["role"] == VAL for v in scores.values()) else TRAIN
-
-
-def as_held_out(scores: dict, role: str) -> dict:
-    """``scores`` with ``role``'s lives in the held-out role and every other life left out, so
-    that :func:`rul_rows` and :func:`healthy_warnings` read them."""
-    return {k: {**v, "role": HELD_OUT if v["role"] == role else "skip"} for k, v in scores.items()}
-
-
-def tune_warning(scores: dict, cal: Calibration, est: TrendRul) -> dict:
-    """Lead time and floor chosen on the validation lives (:func:`tuning_role`; never the
-    held-out ones): the most lives warned >= 5 days ahead, then the fewest warned > 20 days
-    ahead, then the shorter lead."""
-    role = tuning_role(scores)
-    tuning = as_held_out(scores, role)
-    best = None
-    for lead in (6.0, 8.0, 10.0, 12.0, 15.0, 20.0, 25.0):
-        for floor in (0.05, 0.1, 0.15, 0.2, 0.3):
-            rows = rul_rows(tuning, cal, {"trend": est}, lead, floor)
-            ok = warned_share(rows)
-            early = np.mean([(r["warning_lead_days"] or 0) > 20 for r in rows])
-            key = (round(float(ok), 3), -round(float(early), 3), -lead)
-            if best is None or key > best[0]:
-                best = (key, lead, floor)
-    return {"lead_days": best[1], "floor": best[2], "tuned_on": role, "warned_5_days": best[0][0]}
+def first_by_life(group: dict) -> dict[str, dict]:
+    return {life["life"]: life for life in group["warnings"]["per_life"]}
 
 
 def main() -> None:
@@ -286,11 +429,7 @@ def main() -> None:
         help="more training data beside the training lives, e.g. 'outputs/corpus/standard/train_*'",
     )
     ap.add_argument("--name", default=None, help="run name (default: variant_labels_sSEED)")
-    ap.add_argument("--estimators", default="trend,progpy")
-    ap.add_argument(
-        "--lead-days", type=float, default=None, help="default: tuned on the validation lives"
-    )
-    ap.add_argument("--floor", type=float, default=None)
+    ap.add_argument("--estimators", default="trend", help="trend[,progpy] for the RUL metrics")
     ap.add_argument(
         "--override",
         action="append",
@@ -305,16 +444,22 @@ def main() -> None:
     ckpt = train(args.variant, args.seed, args.labels, run_dir, args.epochs, data, args.override)
     train_s = json.loads((ckpt.parent / "train_summary.json").read_text()).get("wall_seconds")
     scores = score_lives(ckpt, index, run_dir)
-    cal, n_cal = calibrate(ckpt, scores)
+    for name, life in scores.items():
+        life["name"] = name
+    add_channels(scores)
+    scales = channel_scales(run_dir, data[1:])
+    cal_days = calibration_days(ckpt, scores)
     trend = TrendRul(threshold=threshold)
+    variants = [m for m in VARIANTS if m.raw != "channel" or scales is not None]
+    rows = [evaluate_variant(m, scores, cal_days, trend, scales)
+            for m in tqdm(variants, desc="index models", disable=None)]  # fmt: skip
+    chosen = max(rows, key=selection_key)
     estimators = {"trend": trend}
     if "progpy" in args.estimators.split(","):
         from robohealth_mj.prognostics.progpy_rul import ProgpyRul
 
         estimators["progpy"] = ProgpyRul(threshold=threshold)
-    tuned = tune_warning(scores, cal, trend)
-    lead = args.lead_days if args.lead_days is not None else tuned["lead_days"]
-    floor = args.floor if args.floor is not None else tuned["floor"]
+    fitted: FittedIndex = chosen["_index"]
     result = {
         "variant": args.variant,
         "seed": args.seed,
@@ -322,21 +467,33 @@ def main() -> None:
         "train_data": data,
         "run": run_dir.name,
         "train_s": train_s,
-        "calibration": vars(cal),
-        "calibration_sessions": n_cal,
-        "warning_tuning": tuned,
-        "lead_days": lead,
-        "floor": floor,
-        "health": {
-            role: health_table(scores, cal, role) for role in (TRAIN, VAL, HELD_OUT, HEALTHY)
-        },
-        "rul": rul_rows(scores, cal, estimators, lead, floor),
-        "healthy": healthy_warnings(scores, cal, trend, lead, floor),
-    }
+        "calibration_sessions": len(cal_days),
+        "band_days": list(DEFAULT_BAND),
+        "chosen": chosen["index_model"],
+        "index_models": [{k: v for k, v in r.items() if k != "_index"} for r in rows],
+        "calibration": fitted.to_json(),
+        "lead_days": chosen["warning"]["lead_days"],
+        "floor": chosen["warning"]["floor"],
+        "rul": [row for name, roles in GROUPS.items() if name != "validation"
+                for row in rul_rows(lives_of(scores, roles), fitted, estimators, name,
+                                    first_by_life(chosen["groups"][name]))],
+    }  # fmt: skip
     atomic_write_json(run_dir / "lives.json", result)
-    atomic_write_json(run_dir / "calibration.json", vars(cal))  # monitor health.calibration=
-    print(json.dumps({k: result[k] for k in ("health", "healthy", "lead_days", "floor")}, indent=1))
-    print(f"-> {run_dir / 'lives.json'}")
+    atomic_write_json(run_dir / "calibration.json", fitted.to_json())  # monitor health.calibration=
+    for r in rows:
+        g = r["groups"]
+        print(
+            f"{r['index_model']:28s} lead {r['warning']['lead_days']:4.0f} floor "
+            f"{r['warning']['floor']:.2f} | "
+            + " | ".join(
+                f"{n}: mae {g[n]['index']['wearing_joint_mae']:.3f} in-band "
+                f"{g[n]['warnings']['in_band']:.2f} early {g[n]['warnings']['early']:.2f} "
+                f"wrong {g[n]['warnings']['wrong_joint']:.2f} "
+                f"h/100d {g[n]['warnings']['warnings_per_100_healthy_days']:.2f}"
+                for n in GROUPS
+            )
+        )
+    print(f"chosen on the validation lives: {chosen['index_model']} -> {run_dir / 'lives.json'}")
 
 
 if __name__ == "__main__":

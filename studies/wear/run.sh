@@ -1,47 +1,39 @@
 #!/usr/bin/env bash
-# Wear over weeks (issue 39): the lives corpus, window models trained on it (and on the standard
-# corpus beside it), the health index, RUL and wear warnings on held-out lives, the figures, and
-# the severity head on the standard held-out session under each window-label rule. On 2 cores:
-# ~20 min (lives corpus), ~20 min (standard corpus, two roles), 10-25 min per model.
+# Wear over weeks (issues 39 and 68). Parts, in order (default: all):
+#   corpus    the lives corpus (~25 min on 2 cores, with issue 68's fresh lives) and the standard
+#             corpus's training and held-out roles (~20 min)
+#   planner   issue 68: gbdt on the standard corpus + training lives at three seeds (~12 min each),
+#             every index model, chosen on the validation lives, figures on held-out and fresh lives
+#   severity  the severity head on the standard held-out session (issue 39; ~45 min)
+# The issue-39 campaign tables (results/lives.md, lives_*.json, calibration_*.json, trend_window.md)
+# were made by the campaign as it stood then: `git show 300430b:studies/wear/run.sh`.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 PY=${PY:-.venv/bin/python}
-$PY -m robohealth_mj.corpus corpus=lives
-$PY -m robohealth_mj.corpus '~corpus.probe_payload_high' '~corpus.probe_unseen_arms' \
-    '~corpus.probe_nominal_arms' '~corpus.healthy_unseen_arms' '~corpus.probe_unseen_program' \
-    '~corpus.val_unseen_program'
-# the first lives' gbdt figures were measured with the severity booster's squared-error objective,
-# the default until 2026-11-26 (now `levels`, chosen on the standard corpus below; on lives after)
-SQ=(--override model.severity_objective=regression)
-$PY studies/wear/campaign.py --variant gbdt --labels last "${SQ[@]}"
-$PY studies/wear/campaign.py --variant stgnn_fixed --labels last --estimators trend
-$PY studies/wear/campaign.py --variant gbdt --train-also 'outputs/corpus/standard/train_*' \
-    --name gbdt_standard+lives_last_s42 "${SQ[@]}"
-# the severity booster as `levels` (the default since 2026-11-26) on lives: standard + lives on
-# three seeds, and lives alone on seed 42 (~20 min each on 2 cores); the corpus's val_lives (added
-# 2026-11-26, ~4 min) are where these runs tune the warning
-for s in 42 43 44; do
-  $PY studies/wear/campaign.py --variant gbdt --seed $s \
-      --train-also 'outputs/corpus/standard/train_*' --name gbdt_standard+lives_levels_s$s
-done
-$PY studies/wear/campaign.py --variant gbdt --labels last --name gbdt_lives_levels_s42
-$PY studies/wear/summarise.py outputs/lives/gbdt_last_s42/lives.json \
-    outputs/lives/stgnn_fixed_last_s42/lives.json \
-    'outputs/lives/gbdt_standard+lives_last_s42/lives.json' \
-    outputs/lives/gbdt_lives_levels_s42/lives.json \
-    'outputs/lives/gbdt_standard+lives_levels_s42/lives.json' \
-    'outputs/lives/gbdt_standard+lives_levels_s43/lives.json' \
-    'outputs/lives/gbdt_standard+lives_levels_s44/lives.json' --out studies/wear/results
-# the trend's window (sessions in its line) on the validation lives
-$PY studies/wear/trend_window.py outputs/lives/gbdt_standard+lives_levels_s4{2,3,4} \
-    > studies/wear/results/trend_window.md
-$PY -m robohealth_mj.report --lives 'outputs/lives/gbdt_standard+lives_levels_s42/lives.json' \
-    --out studies/wear/results/figures
-for run in gbdt_last_s42 stgnn_fixed_last_s42 gbdt_standard+lives_last_s42 gbdt_lives_levels_s42 \
-    gbdt_standard+lives_levels_s42 gbdt_standard+lives_levels_s43 gbdt_standard+lives_levels_s44; do
-  cp "outputs/lives/$run/lives.json" "studies/wear/results/lives_$run.json"
-  cp "outputs/lives/$run/calibration.json" "studies/wear/results/calibration_$run.json"
-done
+PARTS=${*:-corpus planner severity}
+part() { [[ " $PARTS " == *" $1 "* ]]; }
+if part corpus; then
+  $PY -m robohealth_mj.corpus corpus=lives
+  $PY -m robohealth_mj.corpus '~corpus.probe_payload_high' '~corpus.probe_unseen_arms' \
+      '~corpus.probe_nominal_arms' '~corpus.healthy_unseen_arms' '~corpus.probe_unseen_program' \
+      '~corpus.val_unseen_program'
+fi
+if part planner; then
+  for s in 42 43 44; do
+    $PY studies/wear/campaign.py --variant gbdt --seed $s \
+        --train-also 'outputs/corpus/standard/train_*' --name planner_s$s
+  done
+  $PY studies/wear/planner_tables.py outputs/lives/planner_s{42,43,44}/lives.json \
+      > studies/wear/results/planner.md
+  # the wearing joint's severity: the index against the channel each mode acts on
+  $PY studies/wear/severity_channels.py outputs/lives/planner_s42 \
+      > studies/wear/results/severity_channels.md
+  $PY -m robohealth_mj.report --lives outputs/lives/planner_s42/lives.json \
+      --out outputs/lives/planner_s42/figures
+  cp outputs/lives/planner_s42/figures/life_fresh_lives_00_seed6000.png \
+      studies/wear/results/figures/planner_s42_fresh_backlash_wrist1.png
+fi
+part severity || exit 0
 # the severity head on the standard held-out session: trained and scored with each label rule
 for trained in last time_weighted; do
   $PY -m robohealth_mj.train variant=gbdt seed=42 window=32 labels=$trained \

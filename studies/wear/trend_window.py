@@ -1,13 +1,12 @@
-"""The trend estimator's window (sessions in its line), chosen on the validation lives.
+"""The trend estimator's window (sessions in its line) under the chosen index model, chosen on the
+validation lives.
 
-    python studies/wear/trend_window.py outputs/lives/gbdt_standard+lives_levels_s42 [...]
+    python studies/wear/trend_window.py outputs/lives/planner_s42 [...]
 
-For each run and window: the lead time and floor tuned as the campaign tunes them (on the
-validation lives, or the training lives where a corpus has none), those lives' share warned at
-least 5 days ahead and mean prognostic horizon and alpha-lambda accuracy (what chooses), and, for
-the record only, the held-out lives warned at least 5 days ahead and the warnings per 100 healthy
-arm-days. Scores are the runs'
-cached ``health_raw.json``; nothing is retrained.
+For each run (its ``lives.json`` names the chosen index model) and window: the lead time and floor
+tuned as the campaign tunes them, the validation lives' share first warned in band (what chooses),
+and, for the record only, the held-out and fresh lives' share and the warnings per 100 healthy
+arm-days. Scores are the runs' cached ``health_raw.json``; nothing is retrained.
 """
 
 from __future__ import annotations
@@ -17,13 +16,11 @@ import importlib.util
 import json
 from pathlib import Path
 
-import numpy as np
-
-from robohealth_mj.prognostics.health import Calibration
+from robohealth_mj.prognostics.index_model import VARIANTS
 from robohealth_mj.prognostics.rul import TrendRul
 from robohealth_mj.reporting.markdown import heading
 
-WINDOWS = (5, 6, 8, 10, 12)
+WINDOWS = (5, 6, 8, 10, 12, 15)
 
 
 def _campaign():
@@ -39,28 +36,28 @@ def main() -> None:
     ap.add_argument("runs", nargs="+", type=Path)
     args = ap.parse_args()
     c = _campaign()
-    head = ["run", "window", "tuned on", "lead days, floor", "tuning: warned ≥ 5 d",
-            "tuning: PH days", "tuning: alpha-lambda", "held-out warned ≥ 5 d",
-            "held-out: healthy warnings / 100 d"]  # fmt: skip
+    head = ["run", "index model", "window", "lead days, floor", "validation: in band",
+            "held-out: in band", "fresh: in band", "held-out: warnings / 100 d"]  # fmt: skip
     print("\n".join(heading("Trend window, chosen on the validation lives", head)))
     for run in args.runs:
         scores = json.loads((run / "health_raw.json").read_text())
-        cal = Calibration(**json.loads((run / "calibration.json").read_text()))
-        role = c.tuning_role(scores)
-        train = c.as_held_out(scores, role)
+        for name, life in scores.items():
+            life["name"] = name
+        chosen = json.loads((run / "lives.json").read_text())["chosen"]
+        model = next(m for m in VARIANTS if m.name == chosen)
+        c.add_channels(scores)
+        scales = c.channel_scales(run, [])  # the run's, fitted when it ran
+        cal_days = c.calibration_days(run / "model" / "best.ckpt", scores)
         for window in WINDOWS:
             est = TrendRul(threshold=0.8, window=window)
-            t = c.tune_warning(scores, cal, est)
-            lead, floor = t["lead_days"], t["floor"]
-            tr = c.rul_rows(train, cal, {"trend": est}, lead, floor)
-            held = c.rul_rows(scores, cal, {"trend": est}, lead, floor)
-            healthy = c.healthy_warnings(scores, cal, est, lead, floor)
-            warned, tuned = c.warned_share(held), c.warned_share(tr)
+            row = c.evaluate_variant(model, scores, cal_days, est, scales)
+            g, w = row["groups"], row["warning"]
             cells = [
-                run.name, window, role, f"{lead:g}, {floor:g}", f"{tuned:.2f}",
-                f"{np.mean([r['prognostic_horizon'] for r in tr]):.1f}",
-                f"{np.mean([r['alpha_lambda_0.5'] for r in tr]):.2f}", f"{warned:.2f}",
-                f"{healthy['warnings_per_100_healthy_days']:.2f}",
+                run.name, chosen, window, f"{w['lead_days']:g}, {w['floor']:g}",
+                f"{g['validation']['warnings']['in_band']:.2f}",
+                f"{g['held_out']['warnings']['in_band']:.2f}",
+                f"{g['fresh']['warnings']['in_band']:.2f}",
+                f"{g['held_out']['warnings']['warnings_per_100_healthy_days']:.2f}",
             ]  # fmt: skip
             print("| " + " | ".join(str(x) for x in cells) + " |", flush=True)
 

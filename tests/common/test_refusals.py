@@ -34,6 +34,7 @@ def _one_line(capsys, status: SystemExit) -> str:
         ("alarm=3", "alarm=3: alarm takes a block of keys"),
         ("evaluate=maybe", "evaluate='maybe': evaluate takes true or false"),
         ("sim_overrides=7", "sim_overrides=7: sim_overrides takes a list"),
+        ("threads=0", "threads: 0 is not a thread count (a positive integer or auto)"),
     ],
 )
 def test_a_value_of_the_wrong_kind_is_one_line_naming_its_key(capsys, override, said):

@@ -184,7 +184,8 @@ def test_tiny_train_then_evaluate_end_to_end(tiny_corpus, tmp_path):
 
 
 def test_same_seed_same_model(tiny_corpus, tmp_path):
-    cfg = _train_cfg(tiny_corpus, "variant=stgnn_fixed", "trainer.epochs=1")
+    # bytes repeat per thread count (docs/training.md), so the rerun names the count
+    cfg = _train_cfg(tiny_corpus, "variant=stgnn_fixed", "trainer.epochs=1", "threads=1")
     run(cfg, tmp_path / "a")
     run(cfg, tmp_path / "b")
     a, b = (load_checkpoint(tmp_path / d / "best.ckpt")["state_dict"] for d in "ab")

@@ -25,6 +25,9 @@ TINY = [  # two wearing lives of a few 3-second days, one healthy life of two da
     "corpus.roles.healthy_lives.max_days=2",
     "~corpus.roles.heldout_lives",
     "~corpus.roles.val_lives",
+    "~corpus.roles.val_wide_lives",
+    "~corpus.roles.fresh_lives",
+    "~corpus.roles.fresh_healthy_lives",
 ]
 
 

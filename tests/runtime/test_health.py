@@ -55,3 +55,19 @@ def test_the_diagnostics_carry_each_joint_index_band_rul_and_warning(tmp_path):
     assert fields["rul_days.wrist_1"] == "inf" and fields["wear_warning.wrist_1"] == "false"
     state = json.loads((tmp_path / "a.health.json").read_text())
     assert [s["day"] for s in state["sessions"]] == [0, 1, 2, 3, 4, 5]
+
+
+def test_a_monotone_reading_keeps_a_worn_joint_worn_through_a_light_day(tmp_path):
+    """Wear never heals: a day of light duty that reads the elbow low leaves its reported index
+    and its trend where the wear had got to; the stored history keeps the day as read."""
+    plain = HealthTracker(tmp_path / "plain", TrendRul(threshold=0.8), lead_days=10, floor=0.15)
+    worn = HealthTracker(tmp_path / "worn", TrendRul(threshold=0.8), 10, 0.15, monotone=True)
+    readings = [0.1, 0.2, 0.3, 0.4, 0.1]  # the last day the elbow barely turned
+    for day, elbow in enumerate(readings):
+        low, kept = (
+            plain.update("arm", day, _session(elbow)),
+            worn.update("arm", day, _session(elbow)),
+        )
+    assert low[2].index == pytest.approx(0.1) and kept[2].index == pytest.approx(0.8 / 3)
+    assert kept[2].rul.slope > 0 and kept[2].rul.slope > low[2].rul.slope
+    assert [s["index"][2] for s in worn.history("arm")["sessions"]] == readings

@@ -432,6 +432,44 @@ def test_monitor_adds_each_session_to_the_arm_health_history(deployed, tmp_path,
     assert "health arm1 day 1 elbow:" in printed and "RUL" in printed
 
 
+def test_monitor_reads_the_index_through_a_fitted_index_file(deployed, tmp_path):
+    """``health.calibration``: a fitted index (studies/wear) with a map for the elbow alone; the
+    session's elbow index is that map's reading, the other joints the pooled map's. An index that
+    reads friction and backlash from the joints' own channels gets them from the session's
+    samples: on a healthy arm they read near zero wherever the model names those modes."""
+
+    def healthy_day(name: str, index: dict) -> list[float]:
+        (tmp_path / f"{name}.json").write_text(json.dumps(index))
+        monitor_main(
+            [
+                f"model={deployed['structural_onnx']}",
+                "source=sim",
+                "duration_s=4",
+                'sim_overrides=["seed=5","faults=none"]',
+                "quiet=true",
+                f"health.state_dir={tmp_path / name}",
+                "health.day=0",
+                f"health.calibration={tmp_path / f'{name}.json'}",
+            ]
+        )
+        state = json.loads((tmp_path / name / "arm1.health.json").read_text())
+        return state["sessions"][0]["index"]
+
+    elbow = schema.JOINT_NAMES.index("elbow")
+    index = healthy_day("joint", {
+        "index_model": {"raw": "moving", "calibration": "joint", "monotone": True},
+        "x": [0.0, 1.0], "y": [0.0, 1.0],
+        "cells": {f"j{elbow}": {"x": [0.0, 1.0], "y": [0.5, 0.5]}},
+    })  # fmt: skip
+    assert index[elbow] == 0.5 and max(np.delete(index, elbow)) < 0.5
+    read = healthy_day("channel", {
+        "index_model": {"raw": "channel", "calibration": "pooled", "monotone": False},
+        "x": [0.0, 1.0], "y": [0.0, 1.0], "cells": {},
+        "channel_scales": [[10.0] * 6, [0.01] * 6],
+    })  # fmt: skip
+    assert np.isfinite(read).all() and max(read) < 0.2
+
+
 def test_monitor_health_without_a_day_is_one_line(deployed, tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         monitor_main(

@@ -1,0 +1,129 @@
+"""Tables of the planner's figures (issue 68) from the lives campaign's runs.
+
+    python studies/wear/planner_tables.py outputs/lives/planner_s42/lives.json [...] > planner.md
+
+One run per seed. The ablation: every index model's figures on the validation lives (where the
+index model and the warning are chosen), the held-out lives and the fresh lives, averaged over the
+seeds; then the chosen model per seed against the targets; each life's first warning; and the
+wearing joint's index error by mode and joint (where the physics caps it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from robohealth_mj.reporting.markdown import heading
+
+GROUPS = ("validation", "held_out", "fresh")
+
+
+def _fmt(values: list[float], digits: int = 3) -> str:
+    if len(values) == 1:
+        return f"{values[0]:.{digits}f}"
+    return f"{np.mean(values):.{digits}f} ± {np.std(values):.{digits}f}"
+
+
+def ablation(runs: list[dict]) -> list[str]:
+    head = ["index model", "chosen on seeds", "lead, floor (per seed)"]
+    for g in GROUPS:
+        head += [f"{g}: wearing-joint MAE", f"{g}: in band", f"{g}: early / late / wrong / missed",
+                 f"{g}: warnings / 100 healthy d"]  # fmt: skip
+    lines = heading("Index models (mean ± sd over seeds; chosen on the validation lives)", head)
+    names = [r["index_model"] for r in runs[0]["index_models"]]
+    for name in names:
+        rows = [next(r for r in run["index_models"] if r["index_model"] == name) for run in runs]
+        chosen = [str(run["seed"]) for run in runs if run["chosen"] == name]
+        tune = "; ".join(f"{r['warning']['lead_days']:g}, {r['warning']['floor']:g}" for r in rows)
+        cells = [f"**{name}**" if chosen else name, ", ".join(chosen) or "—", tune]
+        for g in GROUPS:
+            w = [r["groups"][g]["warnings"] for r in rows]
+            cells += [
+                _fmt([r["groups"][g]["index"]["wearing_joint_mae"] for r in rows]),
+                _fmt([x["in_band"] for x in w], 2),
+                " / ".join(
+                    f"{np.mean([x[o] for x in w]):.2f}"
+                    for o in ("early", "late", "wrong_joint", "missed")
+                ),
+                _fmt([x["warnings_per_100_healthy_days"] for x in w], 2),
+            ]
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def targets(runs: list[dict]) -> list[str]:
+    head = ["seed", "index model", "lead, floor", "at grid edge"]
+    for g in ("held_out", "fresh"):
+        head += [f"{g}: wearing-joint MAE (≤ 0.05)", f"{g}: other joints read (mean, p95)",
+                 f"{g}: in band (≥ 0.90)", f"{g}: warnings / 100 healthy d (≤ 1)"]  # fmt: skip
+    lines = heading("The chosen index model against the targets", head)
+    for run in runs:
+        row = next(r for r in run["index_models"] if r["index_model"] == run["chosen"])
+        w = row["warning"]
+        cells = [str(run["seed"]), run["chosen"], f"{w['lead_days']:g}, {w['floor']:g}",
+                 "yes" if w["at_edge"] else "no"]  # fmt: skip
+        for g in ("held_out", "fresh"):
+            i, x = row["groups"][g]["index"], row["groups"][g]["warnings"]
+            cells += [
+                f"{i['wearing_joint_mae']:.3f}",
+                f"{i['other_joints_mean_reading']:.3f}, {i['other_joints_p95_reading']:.3f}",
+                f"{x['in_band']:.2f} ({round(x['in_band'] * x['lives'])}/{x['lives']})",
+                f"{x['warnings_per_100_healthy_days']:.2f} ({x['warned_healthy_days']}/"
+                f"{x['healthy_arm_days']} d)",
+            ]
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def per_life(runs: list[dict]) -> list[str]:
+    head = ["group", "life", "mode", "joint", "path", "failure day"]
+    head += [f"seed {run['seed']}: outcome (lead days)" for run in runs]
+    lines = heading("First warning per wearing life (chosen index model)", head)
+    chosen = [next(r for r in run["index_models"] if r["index_model"] == run["chosen"])
+              for run in runs]  # fmt: skip
+    for g in ("held_out", "fresh"):
+        for k, life in enumerate(chosen[0]["groups"][g]["warnings"]["per_life"]):
+            cells = [g, life["life"], life["mode"], life["joint"], life["path"],
+                     f"{life['failure_day']:g}"]  # fmt: skip
+            for row in chosen:
+                x = row["groups"][g]["warnings"]["per_life"][k]
+                lead = "" if x["lead_days"] is None else f" ({x['lead_days']:g})"
+                cells.append(x["outcome"] + lead)
+            lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def strata(runs: list[dict]) -> list[str]:
+    """Wearing-joint MAE by mode and joint over the held-out and fresh lives and seeds."""
+    cell: dict[tuple, list[float]] = defaultdict(list)
+    for run in runs:
+        row = next(r for r in run["index_models"] if r["index_model"] == run["chosen"])
+        for g in ("held_out", "fresh"):
+            for life in row["groups"][g]["index"]["per_life"]:
+                cell[(life["mode"], life["joint"])].append(life["mae"])
+    head = ["mode", "joint", "lives × seeds", "wearing-joint MAE"]
+    lines = heading("Wearing-joint index error by mode and joint (held-out + fresh lives)", head)
+    for (mode, joint), v in sorted(cell.items(), key=lambda kv: -np.mean(kv[1])):
+        lines.append(f"| {mode} | {joint} | {len(v)} | {np.mean(v):.3f} |")
+    return lines
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("runs", nargs="+", type=Path)
+    args = ap.parse_args()
+    runs = [json.loads(p.read_text()) for p in args.runs]
+    print("\n".join(["# Wear figures a planner can trust (issue 68)", "",
+                     f"Runs: {', '.join(str(p) for p in args.runs)}. Band: "
+                     f"{runs[0]['band_days'][0]:g}-{runs[0]['band_days'][1]:g} days before "
+                     "failure, the first warning on any joint.", "",
+                     *targets(runs), "", *ablation(runs), "", *strata(runs), "",
+                     *per_life(runs)]))  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()
