@@ -25,7 +25,7 @@ import numpy as np
 from robohealth_mj.prognostics.rul import TrendRul
 
 OUTCOMES = ("in_band", "early", "late", "wrong_joint", "missed")
-DEFAULT_BAND = (5.0, 20.0)  # days of notice a planner can use (docs/wear.md argues it)
+DEFAULT_BAND = (5.0, 20.0)  # days of notice a planner can use (studies/wear/README.md)
 
 
 @dataclass(frozen=True)
