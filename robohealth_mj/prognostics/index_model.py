@@ -136,6 +136,11 @@ class FittedIndex:
                 out[j] = cal(raw[j])
         return out
 
+    def band(self, low: np.ndarray, high: np.ndarray, reading: np.ndarray) -> tuple:
+        """The raw bootstrap band (``low``, ``high``) through the pooled map, widened to hold
+        ``reading`` (the index as read; a per-cell map or a monotone reading may leave it)."""
+        return np.minimum(self.pooled(low), reading), np.maximum(self.pooled(high), reading)
+
     def online(self, history: np.ndarray) -> np.ndarray:
         """A joint's calibrated history ``[k]`` as the trend reads it on the latest day."""
         return monotone_index(history) if self.model.monotone else np.asarray(history, float)

@@ -292,7 +292,7 @@ class SessionWear:
         health = session_health(attribution_from_probabilities(p_class, p_joint))
         if health.windows == 0:
             raise InputError(f"{self.stream_id}: no decided window this session: no health index")
-        if self.index is not None:  # the calibrated reading; the band mapped as the pooled map
+        if self.index is not None:  # the calibrated reading and its band
             day = {"raw": health.raw, **session_reading(
                 mode_probabilities(p_class, p_joint), np.array(self.moved).reshape(p_joint.shape)
             )}  # fmt: skip
@@ -302,8 +302,7 @@ class SessionWear:
                 raise InputError(f"{self.stream_id}: the index reads the joints' channels, and "
                                  "this source gave none")  # fmt: skip
             health.index = self.index.calibrate(day)
-            health.low = np.minimum(self.index.pooled(health.low), health.index)
-            health.high = np.maximum(self.index.pooled(health.high), health.index)
+            health.low, health.high = self.index.band(health.low, health.high, health.index)
         joints = self.tracker.update(self.stream_id, self.day, health, self.names)
         fields = dict(health_fields(joints))
         for j in joints:

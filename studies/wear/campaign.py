@@ -175,9 +175,9 @@ def channel_scales(run_dir: Path, extra: list[str]) -> np.ndarray | None:
     caches = sorted(p / CACHE for pattern in extra for p in Path().glob(pattern))
     if not caches:
         return None
-    scales = fit_scales([c for c in caches if c.is_file()], len(JOINT_NAMES))
-    atomic_write_json(path, np.round(scales, 8).tolist())
-    return scales
+    scales = np.round(fit_scales([c for c in caches if c.is_file()], len(JOINT_NAMES)), 8)
+    atomic_write_json(path, scales.tolist())
+    return scales  # as written, so that a rerun reading the file reads the same numbers
 
 
 def calibration_days(ckpt: Path, scores: dict) -> list[dict]:
@@ -372,8 +372,8 @@ def rul_rows(
         j = JOINT_NAMES.index(life["joint"])
         daily = np.stack([index.calibrate(d) for d in life["days"]])[:, j]
         seen = index.life(life["days"])[:, j]
-        low = np.minimum(index.pooled(np.array([d["low"][j] for d in life["days"]])), seen)
-        high = np.maximum(index.pooled(np.array([d["high"][j] for d in life["days"]])), seen)
+        low, high = index.band(np.array([d["low"][j] for d in life["days"]]),
+                               np.array([d["high"][j] for d in life["days"]]), seen)  # fmt: skip
         truth = np.array([d["truth"][j] for d in life["days"]])
         eol, onset = float(life["failure_day"]), float(days[np.argmax(truth > 0)])
         for est_name, est in estimators.items():

@@ -21,15 +21,15 @@ import json
 from collections import defaultdict
 from pathlib import Path
 
+import campaign  # this folder's lives campaign: the runs' cached scores and channels
 import numpy as np
 
-from robohealth_mj.prognostics.channels import MODES, channel_readings, fit_scales
+from robohealth_mj.prognostics.channels import MODES
 from robohealth_mj.prognostics.health import monotone_index
 from robohealth_mj.prognostics.index_model import FittedIndex
 from robohealth_mj.reporting.markdown import heading
 from robohealth_mj.schema import JOINT_NAMES
 
-CORPUS = Path("outputs/corpus/lives")
 GROUPS = ("heldout_lives", "fresh_lives")
 
 
@@ -49,28 +49,14 @@ def main() -> None:
     ap.add_argument("run", type=Path)
     ap.add_argument("--standard", default="outputs/corpus/standard", type=Path)
     args = ap.parse_args()
-    scores = json.loads((args.run / "health_raw.json").read_text())
+    scores = {k: v for k, v in json.loads((args.run / "health_raw.json").read_text()).items()
+              if v["role"] in GROUPS and v["joint"]}  # fmt: skip
+    campaign.add_channels(scores)
     index = FittedIndex.load(args.run / "calibration.json")
-    n = len(JOINT_NAMES)
-    scales = fit_scales(sorted(args.standard.glob("train_*/graphs.jsonl.cache.npz")), n)
+    scales = campaign.channel_scales(args.run, [f"{args.standard}/train_*"])
     rows: dict[str, list] = defaultdict(list)
-    for name, life in scores.items():
-        if life["role"] not in GROUPS or not life["joint"]:
-            continue
+    for life in scores.values():
         j = JOINT_NAMES.index(life["joint"])
-        every = np.array(
-            [
-                channel_readings(
-                    np.load(CORPUS / name / f"day_{int(d['day']):03d}" / "graphs.jsonl.cache.npz")[
-                        "x"
-                    ],
-                    n,
-                )
-                for d in life["days"]
-            ]
-        )  # fmt: skip  [S, 2, J]
-        for d, r in zip(life["days"], every, strict=True):
-            d["channel"] = r.tolist()
         truth = np.array([d["truth"][j] for d in life["days"]])
         daily = np.array([index.calibrate(d)[j] for d in life["days"]])
         seen = index.life(life["days"])[:, j]
@@ -79,7 +65,7 @@ def main() -> None:
                "index_span": seen[-1] / max(truth[-1], 1e-9)}  # fmt: skip
         if life["mode"] in MODES:
             m = MODES.index(life["mode"])
-            readings = every[:, m, j]
+            readings = np.array([d["channel"][m][j] for d in life["days"]])
             ok = np.isfinite(readings)
             units = np.clip(np.nan_to_num(readings / scales[m, j]), 0.0, 1.0)
             reading = np.array([monotone_index(units[: k + 1])[-1] for k in range(len(units))])

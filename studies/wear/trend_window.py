@@ -12,9 +12,10 @@ arm-days. Scores are the runs' cached ``health_raw.json``; nothing is retrained.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 from pathlib import Path
+
+import campaign  # this folder's lives campaign: scoring, calibration, the warning
 
 from robohealth_mj.prognostics.index_model import VARIANTS
 from robohealth_mj.prognostics.rul import TrendRul
@@ -23,19 +24,11 @@ from robohealth_mj.reporting.markdown import heading
 WINDOWS = (5, 6, 8, 10, 12, 15)
 
 
-def _campaign():
-    path = Path(__file__).with_name("campaign.py")
-    spec = importlib.util.spec_from_file_location("lives_campaign", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", type=Path)
     args = ap.parse_args()
-    c = _campaign()
+    c = campaign
     head = ["run", "index model", "window", "lead days, floor", "validation: in band",
             "held-out: in band", "fresh: in band", "held-out: warnings / 100 d"]  # fmt: skip
     print("\n".join(heading("Trend window, chosen on the validation lives", head)))
