@@ -24,6 +24,7 @@ COMMANDS = (
     ("tune_alarms", "", "choose alarm settings on a selection recording"),
     ("monitor", "", "diagnose a simulated, replayed or live (ROS 2) stream"),
     ("robot", "monitor", "simulated or replayed arms publishing on a ROS 2 bus"),
+    ("keystore", "monitor", "an SROS2 keystore and enclaves, without ROS installed"),
     ("render", "sim", "a fault episode rendered headless to GIF/MP4"),
     ("bag", "", "recordings to and from ROS 2 bags"),
     ("ingest", "", "a controller log (UR RTDE, voraus-AD, any mapped table) to a recording"),

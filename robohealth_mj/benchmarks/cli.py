@@ -10,6 +10,7 @@
     python -m robohealth_mj.bench streams --profile 1000 2000 [--shards 1]
     python -m robohealth_mj.bench soak [--model M] [--streams 1000] [--seconds 60]
     python -m robohealth_mj.bench ros2 --model M [--arms 10 25 50] [--seconds 20] [--monitors 1 2]
+        [--graphs open secured]
     python -m robohealth_mj.bench contact [--streams 100 1000 4000]
     python -m robohealth_mj.bench mixed --model A.onnx B.onnx --data A_DATA B_DATA [--streams 500]
 
@@ -78,7 +79,7 @@ def main(argv: list[str] | None = None) -> None:
     mixed.add_argument("--streams", type=int, default=500, help="streams of each arm kind")
     mixed.add_argument("--ticks", type=int, default=100, help="timed ticks per run")
     mixed.add_argument("--rounds", type=int, default=3, help="alternated rounds")
-    ros2.add_argument("--model", required=True, help="an exported model.onnx")
+    ros2.add_argument("--model", required=True, help="an exported model.onnx or a ready one")
     ros2.add_argument("--data", default="outputs/corpus/quick/heldout_seed900")
     ros2.add_argument("--arms", type=int, nargs="+", default=[10, 25, 50])
     ros2.add_argument("--seconds", type=float, default=20.0)
@@ -90,6 +91,11 @@ def main(argv: list[str] | None = None) -> None:
     ros2.add_argument(
         "--health-hz", type=float, default=20.0, help="each arm's /health_diagnosis rate"
     )
+    ros2.add_argument(
+        "--graphs", nargs="+", default=["open"], choices=["open", "secured"],
+        help="open and/or SROS2-secured graph (secured: a keystore made for the run; needs the "
+        "binding of `make setup-sros2`), one row each, side by side",
+    )  # fmt: skip
     ros2.add_argument(
         "--diagnose-wait-s", type=float, default=0.02,
         help="how long a completed sample waits for the other arms' (ros2.diagnose_wait_s)",
@@ -144,9 +150,12 @@ def main(argv: list[str] | None = None) -> None:
         bench_contact(args.streams)
     elif args.what == "ros2":
         from robohealth_mj.benchmarks.ros2 import bench_ros2
+        from robohealth_mj.common.errors import one_line_errors
 
-        bench_ros2(args.model, args.data, args.arms, args.seconds, args.layouts, args.monitors,
-                   args.health_hz, args.diagnose_wait_s)  # fmt: skip
+        with one_line_errors("bench"):
+            bench_ros2(args.model, args.data, args.arms, args.seconds, args.layouts,
+                       args.monitors, args.health_hz, args.diagnose_wait_s,
+                       args.graphs)  # fmt: skip
     elif args.what in ("streams", "soak"):
         from robohealth_mj.benchmarks.fleet import bench_fleet, bench_soak
         from robohealth_mj.common.errors import one_line_errors

@@ -4,12 +4,16 @@ latency from a robot's publish to the diagnosis on ``/diagnostics``.
 Publishers run in a child process (replaying a recording, stamps set to the wall clock at publish,
 so the monitor reads each sample's age directly); the monitors run in their own processes, each
 a share of the arms (scale-out: ``--monitors 1 2``). CPU is reported apart
-for each side (process time over wall time, in cores)."""
+for each side (process time over wall time, in cores). ``--graphs open secured``: each row on an
+open graph and on an SROS2-secured one (a keystore made for the run: the robot's and the
+monitor's enclaves with their grants, the default governance: encrypted and signed), one after
+the other in the same run."""
 
 from __future__ import annotations
 
 import itertools
 import multiprocessing as mp
+import tempfile
 import time
 from typing import Any
 
@@ -17,12 +21,13 @@ import numpy as np
 
 
 def _publisher(
-    domain: int, arms: int, samples: list, seconds: float, layout: str, ready, go, out
-) -> None:
+    domain: int, arms: int, samples: list, seconds: float, layout: str, ready, go, out,
+    security=None,
+) -> None:  # fmt: skip
     from robohealth_mj.ros2.bus import Bus, BusConfig
     from robohealth_mj.ros2.node import ArmPublisher
 
-    bus = Bus(BusConfig(domain_id=domain, interface="127.0.0.1", depth=50))
+    bus = Bus(BusConfig(domain_id=domain, interface="127.0.0.1", depth=50, security=security))
     from robohealth_mj.bags.topics import BagTopics
 
     pubs = [ArmPublisher(bus, f"arm{k + 1}", layout=layout) for k in range(arms)]
@@ -53,7 +58,7 @@ def _publisher(
 
 def _monitor(
     domain: int, model: str, arms: list[str], seconds: float, layout: str, expected: int,
-    health_hz: float, diagnose_wait_s: float, ready, go, out,
+    health_hz: float, diagnose_wait_s: float, ready, go, out, security=None,
 ) -> None:  # fmt: skip
     """One monitor process: its share of the arms, until every sample came or time ran out."""
     from robohealth_mj.ros2.bus import Bus, BusConfig
@@ -65,7 +70,7 @@ def _monitor(
     def on_diagnosis(arm: str, sample, d) -> None:
         latencies.append(time.time() - sample.t)
 
-    bus = Bus(BusConfig(domain_id=domain, interface="127.0.0.1", depth=50))
+    bus = Bus(BusConfig(domain_id=domain, interface="127.0.0.1", depth=50, security=security))
     node = MonitorNode(bus, ModelRuntime(model), arms, on_diagnosis=on_diagnosis, layout=layout,
                        health_diagnosis_hz=health_hz,
                        diagnose_wait_s=diagnose_wait_s)  # fmt: skip
@@ -89,9 +94,12 @@ def _monitor(
 def run_once(
     model: str, samples: list, arms: int, seconds: float, domain: int, layout: str,
     monitors: int = 1, health_hz: float = 20.0, diagnose_wait_s: float = 0.02,
+    security: dict | None = None,
 ) -> dict[str, Any]:  # fmt: skip
     """Publishers in one child process; ``monitors`` monitor processes, each a stable-hash
-    share of the arms (as ``ros2.partition=k/n`` splits them); CPU per side in cores."""
+    share of the arms (as ``ros2.partition=k/n`` splits them); CPU per side in cores.
+    ``security``: the robot's and the monitor's enclaves (:func:`secured_graph`)."""
+    security = security or {}
     from robohealth_mj.ros2.node import in_partition
 
     ctx = mp.get_context("spawn")
@@ -106,17 +114,19 @@ def run_once(
         children.append(ctx.Process(target=_monitor, args=(
             domain, model, share, seconds, layout, ticks * len(share), health_hz,
             diagnose_wait_s, ready, go,
-            results)))  # fmt: skip
+            results, security.get("monitor"))))  # fmt: skip
         readies.append(ready)
     publisher_ready = ctx.Event()
     children.append(ctx.Process(
-        target=_publisher, args=(domain, arms, samples, seconds, layout, publisher_ready, go, out)
+        target=_publisher,
+        args=(domain, arms, samples, seconds, layout, publisher_ready, go, out,
+              security.get("robot")),
     ))  # fmt: skip
     for child in children:
         child.start()
     for ready in [*readies, publisher_ready]:
         ready.wait(120)
-    time.sleep(1.5)  # discovery
+    time.sleep(1.5 if not security else 4.0)  # discovery (and the handshakes)
     go.set()
     published = out.get(timeout=seconds + 60)
     parts = [results.get(timeout=seconds + 60) for _ in shares]
@@ -146,30 +156,63 @@ def run_once(
     }
 
 
+def secured_graph(root: Any, domain: int, arms: int, layout: str) -> dict[str, Any]:
+    """A keystore for one benchmark row: the robot's and the monitor's enclaves, each with
+    what ``python -m robohealth_mj.keystore`` grants them for these arms and layout."""
+    from robohealth_mj.common.config import compose_config
+    from robohealth_mj.ros2.grants import monitor_grant, robot_grant
+    from robohealth_mj.ros2.keystore import create_enclave, create_keystore
+    from robohealth_mj.ros2.security import resolve_security
+
+    cfg = compose_config("keystore", [f"ros2.count={arms}", f"ros2.layout={layout}"]).ros2
+    keystore = create_keystore(f"{root}/keys_{domain}", domain)
+    out = {}
+    for role, grant in (("robot", robot_grant), ("monitor", monitor_grant)):
+        create_enclave(keystore, f"/bench/{role}", grant(cfg))
+        settings = {"enable": True, "strategy": "Enforce", "keystore": str(keystore.root),
+                    "enclave": f"/bench/{role}"}  # fmt: skip
+        out[role] = resolve_security(settings, domain, environ={})
+    return out
+
+
 def bench_ros2(
     model: str, data: str, arms_list: list[int], seconds: float, layouts: list[str],
     monitors: list[int] | None = None, health_hz: float = 20.0, diagnose_wait_s: float = 0.02,
+    graphs: list[str] | None = None,
 ) -> list[dict]:  # fmt: skip
     from robohealth_mj.data.arrays import resolve_recordings
     from robohealth_mj.data.read import read_samples
+    from robohealth_mj.runtime.ready import resolve_model
 
+    model = resolve_model(model)  # a file, or a ready model by name (full, stock, ur_driver)
     samples = list(itertools.islice(read_samples(resolve_recordings([data])[0]), 400))
     domains = itertools.count(150)
     rows = []
     print(
-        f"{'layout':>10} {'mon':>3} {'arms':>5} {'msg/s':>7} {'lost':>6} {'bad':>4} {'p50 ms':>7} "
-        f"{'p99 ms':>7} {'monitor CPU':>11} {'publisher CPU':>13}   monitor time by phase"
+        f"{'graph':>7} {'layout':>10} {'mon':>3} {'arms':>5} {'msg/s':>7} {'lost':>6} {'bad':>4} "
+        f"{'p50 ms':>7} {'p99 ms':>7} {'monitor CPU':>11} {'publisher CPU':>13}   "
+        "monitor time by phase"
     )
-    for layout, n, arms in itertools.product(layouts, monitors or [1], arms_list):
-        r = run_once(model, samples, arms, seconds, next(domains), layout, n, health_hz,
-                     diagnose_wait_s)  # fmt: skip
-        r["layout"] = layout
-        rows.append(r)
-        print(
-            f"{layout:>10} {n:>3} {r['arms']:>5} {r['messages_per_s']:>7} {r['lost']:>6} "
-            f"{r['problems']:>4} {r['latency_p50_ms']:>7.1f} {r['latency_p99_ms']:>7.1f} "
-            f"{r['monitor_cpu_cores']:>10.2f}c {r['publisher_cpu_cores']:>12.2f}c   "
-            + "  ".join(f"{k} {v:.2f}c" for k, v in r["monitor_seconds"].items()),
-            flush=True,
-        )
+    with tempfile.TemporaryDirectory(prefix="bench_sros2_") as root:
+        for layout, n, arms, graph in itertools.product(
+            layouts, monitors or [1], arms_list, graphs or ["open"]
+        ):
+            domain = next(domains)
+            security = secured_graph(root, domain, arms, layout) if graph == "secured" else None
+            r = run_once(model, samples, arms, seconds, domain, layout, n, health_hz,
+                         diagnose_wait_s, security)  # fmt: skip
+            r["layout"], r["graph"] = layout, graph
+            rows.append(r)
+            _print_row(r, n)
     return rows
+
+
+def _print_row(r: dict, n: int) -> None:
+    print(
+        f"{r['graph']:>7} {r['layout']:>10} {n:>3} {r['arms']:>5} {r['messages_per_s']:>7} "
+        f"{r['lost']:>6} {r['problems']:>4} {r['latency_p50_ms']:>7.1f} "
+        f"{r['latency_p99_ms']:>7.1f} {r['monitor_cpu_cores']:>10.2f}c "
+        f"{r['publisher_cpu_cores']:>12.2f}c   "
+        + "  ".join(f"{k} {v:.2f}c" for k, v in r["monitor_seconds"].items()),
+        flush=True,
+    )

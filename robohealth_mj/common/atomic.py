@@ -9,12 +9,13 @@ from pathlib import Path
 from typing import Any
 
 
-def atomic_write_bytes(path: Path | str, payload: bytes) -> None:
+def atomic_write_bytes(path: Path | str, payload: bytes, mode: int = 0o644) -> None:
+    """``mode``: the file's permissions (0o600 for a secret: a key never exists readable)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        os.chmod(tmp, 0o644)  # mkstemp makes owner-only files; artefacts are meant to be shared
+        os.chmod(tmp, mode)  # mkstemp makes owner-only files; artefacts are meant to be shared
         with os.fdopen(fd, "wb") as handle:
             handle.write(payload)
             handle.flush()

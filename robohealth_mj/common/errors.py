@@ -34,7 +34,7 @@ EXTRA_OF = {
     **dict.fromkeys(
         ("torch", "torch_geometric", "lightgbm", "sklearn", "onnxscript", "tensorboard"), "train"
     ),
-    **dict.fromkeys(("cyclonedds", "pyarrow"), "monitor"),
+    **dict.fromkeys(("cyclonedds", "pyarrow", "cryptography"), "monitor"),
     "progpy": "prognostics",
 }
 

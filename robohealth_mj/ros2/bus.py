@@ -17,11 +17,16 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cache
 from typing import Any
 from xml.sax.saxutils import escape
+
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.ros2.security import Security
 
 EPROSIMA_VENDOR_ID = "1.15"  # Fast DDS's RTPS vendor id, as Cyclone writes it
 
@@ -33,9 +38,12 @@ class BusConfig:
     ignore_type_information: bool = True  # Fast DDS 3 peers: without it nothing passes
     reliable_subscriptions: bool = False  # default: best effort (matches every writer)
     depth: int = 10  # history depth of readers and writers
+    security: Security | None = None  # SROS2: the enclave this participant joins as
 
     def xml(self) -> str:
-        """Cyclone DDS's configuration for this participant's domain."""
+        """Cyclone DDS's configuration for this participant's domain. The type-information
+        setting exists from Cyclone 11 on; the secured binding (0.10, ``make setup-sros2``)
+        refuses a configuration that names it, and leaves it out."""
         general = discovery = ""
         if self.interface:
             attr = "address" if self.interface[0].isdigit() else "name"
@@ -54,10 +62,18 @@ class BusConfig:
         compat = (
             f"<Compatibility><IgnoreTypeInformation>{EPROSIMA_VENDOR_ID}"
             "</IgnoreTypeInformation></Compatibility>"
-            if self.ignore_type_information
+            if self.ignore_type_information and binding_major() >= 11
             else ""
         )
         return f'<CycloneDDS><Domain id="any">{general}{discovery}{compat}</Domain></CycloneDDS>'
+
+
+@cache
+def binding_major() -> int:
+    """The installed Cyclone DDS binding's major version (11 for PyPI's wheel)."""
+    from importlib.metadata import version
+
+    return int(version("cyclonedds").split(".")[0])
 
 
 def domain_config(config: BusConfig, environ: Mapping[str, str] = os.environ) -> str:
@@ -89,23 +105,72 @@ def _domain(config: BusConfig) -> Any:
     return known[1]
 
 
+class _MatchedStatus(ctypes.Structure):
+    """``dds_publication_matched_status_t``."""
+
+    _fields_ = [("total_count", ctypes.c_uint32), ("total_count_change", ctypes.c_int32),
+                ("current_count", ctypes.c_uint32), ("current_count_change", ctypes.c_int32),
+                ("last_subscription_handle", ctypes.c_uint64)]  # fmt: skip
+
+
+@cache
+def _ddsc() -> ctypes.CDLL:
+    from robohealth_mj.ros2.security import binding_library
+
+    return ctypes.CDLL(str(binding_library()))
+
+
 class Bus:
     """A participant on one domain with the topics, readers and writers made through it."""
 
     def __init__(self, config: BusConfig) -> None:
+        from cyclonedds.core import DDSException, Policy, Qos
         from cyclonedds.domain import DomainParticipant
 
         self.config = config
         self._domain = _domain(config)
-        self.participant = DomainParticipant(config.domain_id)
+        qos = None
+        if (security := config.security) is not None:
+            qos = Qos(*(Policy.Property(k, v) for k, v in security.properties().items()))
+        try:
+            self.participant = DomainParticipant(config.domain_id, qos=qos)
+        except DDSException as exc:
+            if security is None:
+                raise
+            raise InputError(
+                f"ros2.security: DDS Security refused enclave {security.enclave} "
+                f"({security.folder}): its certificate, key or signed files do not verify "
+                f"against the keystore's CA, or it is not allowed on domain {config.domain_id} "
+                f"(DDS error {exc.code})"
+            ) from None
         self._topics: dict[str, Any] = {}
 
+    def _refused(self, exc: Exception, what: str) -> Exception:
+        """A reader, writer or topic the enclave's permissions do not grant: one line naming
+        them; any other error as it was."""
+        from cyclonedds.core import DDSException
+
+        security = self.config.security
+        if (
+            security is None
+            or getattr(exc, "code", None) != DDSException.DDS_RETCODE_NOT_ALLOWED_BY_SECURITY
+        ):
+            return exc
+        return InputError(
+            f"ros2.security: enclave {security.enclave} may not {what} (its permissions: "
+            f"{security.folder / 'permissions.xml'})"
+        )
+
     def _topic(self, name: str, cls: type) -> Any:
+        from cyclonedds.core import DDSException
         from cyclonedds.topic import Topic
 
         key = dds_topic(name)
         if key not in self._topics:
-            self._topics[key] = Topic(self.participant, key, cls)
+            try:
+                self._topics[key] = Topic(self.participant, key, cls)
+            except DDSException as exc:
+                raise self._refused(exc, f"use topic {name!r}") from None
         elif self._topics[key].data_type is not cls:
             raise ValueError(f"topic {name!r} is {self._topics[key].data_type.__name__} here")
         return self._topics[key]
@@ -126,16 +191,27 @@ class Bus:
 
     def writer(self, name: str, cls: type) -> Any:
         """A writer with ROS 2's default profile (reliable)."""
+        from cyclonedds.core import DDSException
         from cyclonedds.pub import DataWriter
 
-        return DataWriter(self.participant, self._topic(name, cls), self._qos(reliable=True))
+        topic = self._topic(name, cls)
+        try:
+            return DataWriter(self.participant, topic, self._qos(reliable=True))
+        except DDSException as exc:
+            raise self._refused(exc, f"publish {name!r}") from None
 
     def reader(self, name: str, cls: type) -> Any:
         """A reader, best effort unless ``reliable_subscriptions``."""
+        from cyclonedds.core import DDSException
         from cyclonedds.sub import DataReader
 
-        reliable = self.config.reliable_subscriptions
-        return DataReader(self.participant, self._topic(name, cls), self._qos(reliable))
+        topic = self._topic(name, cls)
+        try:
+            return DataReader(
+                self.participant, topic, self._qos(self.config.reliable_subscriptions)
+            )
+        except DDSException as exc:
+            raise self._refused(exc, f"subscribe to {name!r}") from None
 
     @staticmethod
     def serialize(writer: Any, msg: Any) -> bytes:
@@ -153,6 +229,19 @@ class Bus:
         ret = ddspy_write(writer._ref, data)
         if ret < 0:
             raise DDSException(ret, f"Occurred while writing sample in {writer!r}")
+
+    @staticmethod
+    def matched_readers(writer: Any) -> int:
+        """How many readers ``writer`` is matched with now (on a secured graph: authenticated,
+        permitted and with keys exchanged). From the C library: the 0.10 binding has no
+        Python call for it."""
+        status = _MatchedStatus()
+        ret = _ddsc().dds_get_publication_matched_status(writer._ref, ctypes.byref(status))
+        if ret < 0:
+            from cyclonedds.core import DDSException
+
+            raise DDSException(ret, f"Occurred while reading the matched status of {writer!r}")
+        return int(status.current_count)
 
     def close(self) -> None:
         """Delete the participant (and with it every reader, writer and topic)."""

@@ -457,7 +457,13 @@ def _take() -> tuple[Callable, int]:
     from cyclonedds._clayer import ddspy_take
     from cyclonedds.core import InstanceState, SampleState, ViewState
 
-    _TAKE = ddspy_take, int(SampleState.Any | ViewState.Any | InstanceState.Any)
+    from robohealth_mj.ros2.bus import binding_major
+
+    mask = int(SampleState.Any | ViewState.Any | InstanceState.Any)
+    if binding_major() < 11:  # the secured binding's (0.10) take has no mask: it takes any
+        _TAKE = (lambda ref, _mask, limit: ddspy_take(ref, limit)), mask
+    else:
+        _TAKE = ddspy_take, mask
     return _TAKE
 
 

@@ -20,7 +20,10 @@ from robohealth_mj.schema import GraphSample
 
 
 def bus_config(cfg: DictConfig) -> Any:
+    """The participant ``ros2.*`` describes, its SROS2 enclave resolved (one line where an
+    enforced one cannot be used)."""
     from robohealth_mj.ros2.bus import BusConfig
+    from robohealth_mj.ros2.security import resolve_security
 
     return BusConfig(
         domain_id=int(cfg.domain_id),
@@ -28,6 +31,7 @@ def bus_config(cfg: DictConfig) -> Any:
         ignore_type_information=bool(cfg.ignore_type_information),
         reliable_subscriptions=bool(cfg.get("reliable_subscriptions", False)),
         depth=int(cfg.get("depth", 10)),
+        security=resolve_security(cfg.get("security"), int(cfg.domain_id)),
     )
 
 
@@ -107,7 +111,8 @@ def run_monitor(
     arms = arm_names(cfg)
     if not arms:
         raise ValueError("ros2: no arms in this process's partition")
-    bus = Bus(bus_config(cfg))
+    config = bus_config(cfg)
+    bus = Bus(config)
     node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
                        stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
                        health_diagnosis_hz=float(cfg.get("health_diagnosis_hz", 20.0)),
@@ -116,8 +121,10 @@ def run_monitor(
                        **layout_options(cfg, tracking, model_arm(runtime)))  # fmt: skip
     started = time.monotonic()
     last_report = started
-    print(f"ros2 monitor: {len(arms)} arms on domain {cfg.domain_id} ({', '.join(arms[:5])}"
-          f"{' …' if len(arms) > 5 else ''}); Ctrl-C to stop", flush=True)  # fmt: skip
+    secured = f", secured as {config.security.enclave}" if config.security else ""
+    print(f"ros2 monitor: {len(arms)} arms on domain {cfg.domain_id}{secured} "
+          f"({', '.join(arms[:5])}{' …' if len(arms) > 5 else ''}); Ctrl-C to stop",
+          flush=True)  # fmt: skip
     with stop_on_signals() as stop:
         try:
             while not stop.is_set():
@@ -145,6 +152,20 @@ def run_monitor(
     }
 
 
+def wait_for_subscribers(writers: list[Any], timeout_s: float) -> bool:
+    """Until every writer has matched a reader (on a secured graph: its keys exchanged), at
+    most ``timeout_s``: what is written before a reader matches never reaches it. Whether all
+    did."""
+    from robohealth_mj.ros2.bus import Bus
+
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if all(Bus.matched_readers(w) for w in writers):
+            return True
+        time.sleep(0.05)
+    return False
+
+
 def run_robot(cfg: DictConfig, stream: Iterator[tuple[float, GraphSample]]) -> int:
     """Publish each sample of ``stream`` on every configured arm, paced at ``speed`` x real
     time (0: as fast as possible); returns the ticks published."""
@@ -154,7 +175,7 @@ def run_robot(cfg: DictConfig, stream: Iterator[tuple[float, GraphSample]]) -> i
 
     bus = Bus(bus_config(cfg.ros2))
     arms = [ArmPublisher(bus, arm, **layout_options(cfg.ros2)) for arm in arm_names(cfg.ros2)]
-    time.sleep(float(cfg.discovery_s))  # let subscribers match before the first sample
+    wait_for_subscribers([w for arm in arms for w in arm.writers.values()], float(cfg.discovery_s))
     ticks, started, t0 = 0, time.perf_counter(), None
     with stop_on_signals() as stop:
         try:

@@ -87,6 +87,16 @@ def driver_topics(topics: BagTopics, arm: str, driver: DriverConfig, namespace: 
     }
 
 
+def arm_kinds(
+    names: BagTopics, arm: str, layout: str, driver: DriverConfig | None, namespace: str
+) -> dict[str, type]:
+    """One arm's topics in ``layout`` (``names``: under its namespace) -> their message classes:
+    what a robot publishes and the monitor reads."""
+    if layout == "ur_driver":
+        return driver_topics(names, arm, driver or DriverConfig(), namespace)
+    return {t: TYPES[k] for t, k in layout_topics(names, layout).items()}
+
+
 def poll_paced(node: MonitorNode, period_s: float) -> int:
     """One poll of ``node``, then the rest of ``period_s``: what arrived meanwhile is taken in
     one go and diagnosed in one runtime step (fewer, larger takes and steps: polling as fast as
@@ -121,9 +131,7 @@ class ArmPublisher:
         if layout == "ur_driver":
             self.driver = DriverMessages(arm_joint_names(joint_names, tf_prefix.format(arm=arm)),
                                          driver or DriverConfig())  # fmt: skip
-            kinds = driver_topics(self.topics, arm, self.driver.config, namespace)
-        else:
-            kinds = {t: TYPES[k] for t, k in layout_topics(self.topics, layout).items()}
+        kinds = arm_kinds(self.topics, arm, layout, driver, namespace)
         self.writers = {name: bus.writer(name, cls) for name, cls in kinds.items()}
 
     def messages(self, sample: GraphSample, topics: BagTopics | None = None) -> list[tuple]:
@@ -229,12 +237,10 @@ class MonitorNode:
         for arm in arms:
             names = arm_topics(arm, topics, namespace)
             joints = arm_joint_names(joint_names, tf_prefix.format(arm=arm))
+            kinds = arm_kinds(names, arm, layout, driver, namespace)
             if layout == "ur_driver":
-                driver = driver or DriverConfig()
-                kinds = driver_topics(names, arm, driver, namespace)
-                assembler = DriverAssembler(arm, *kinds, joints, driver)
+                assembler = DriverAssembler(arm, *kinds, joints, driver or DriverConfig())
             else:
-                kinds = {t: TYPES[k] for t, k in layout_topics(names, layout).items()}
                 aggregated = names.aggregated if layout == "aggregated" else None
                 assembler = ArmAssembler(arm, names, require_truth=require_truth,
                                          aggregated=aggregated, sensors=layout != "joints",
@@ -375,10 +381,14 @@ class MonitorNode:
     def check_writers(self) -> None:
         """A writer on an arm's topic that cannot match (another message type, or a QoS the
         reader cannot take) marks that arm: DDS reports it as a requested-incompatible QoS
-        (type consistency for a wrong type)."""
+        (type consistency for a wrong type). The secured binding (Cyclone 0.10) has no such
+        status in Python: there a mismatched writer shows only as the arm going STALE."""
         for state in self.arms.values():
             for topic, kind, reader in state.readers:
-                status = reader.get_requested_incompatible_qos_status()
+                incompatible = getattr(reader, "get_requested_incompatible_qos_status", None)
+                if incompatible is None:
+                    return
+                status = incompatible()
                 if status.total_count_change:
                     cause = INCOMPATIBLE.get(status.last_policy_id, "QoS")
                     state.problem = state.last_problem = (

@@ -1,0 +1,78 @@
+"""What each participant of this project may do on a secured graph, from the same ``ros2.*``
+settings the monitor and the simulated arms run with: the topics each one opens, and no other.
+
+Each grant is built through ``conf/grant/<name>.yaml`` by ``python -m robohealth_mj.keystore``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from robohealth_mj.common.errors import InputError
+from robohealth_mj.ros2.keystore import Grant
+
+
+def _arm_topics(ros2: Any) -> dict[str, list[str]]:
+    """Each configured arm's topics in the configured layout (as the monitor and robot open
+    them), and where its diagnosis is published."""
+    from robohealth_mj.ros2.live import arm_names, layout_options
+    from robohealth_mj.ros2.node import arm_kinds, arm_topics
+
+    options = layout_options(ros2)
+    out = {}
+    for arm in arm_names(ros2):
+        names = arm_topics(arm, None, options["namespace"])
+        kinds = arm_kinds(names, arm, options["layout"], options["driver"], options["namespace"])
+        out[arm] = [*kinds, names.health_diagnosis]
+    if not out:
+        raise InputError("ros2.arms: no arms to grant (ros2.arms=[...] or ros2.count=N)")
+    return out
+
+
+def monitor_grant(ros2: Any) -> Grant:
+    """The monitor: read every arm's topics; write ``/diagnostics`` and each arm's
+    ``health_diagnosis``; nothing else."""
+    from robohealth_mj.ros2.node import DIAGNOSTICS_TOPIC
+
+    arms = _arm_topics(ros2)
+    read = [t for topics in arms.values() for t in topics[:-1]]
+    write = [DIAGNOSTICS_TOPIC, *(topics[-1] for topics in arms.values())]
+    return Grant(publish=tuple(dict.fromkeys(write)), subscribe=tuple(dict.fromkeys(read)))
+
+
+def robot_grant(ros2: Any) -> Grant:
+    """A robot (``python -m robohealth_mj.robot``, or a driver's stand-in): write its arms'
+    topics; read nothing."""
+    arms = _arm_topics(ros2)
+    return Grant(publish=tuple(dict.fromkeys(t for topics in arms.values() for t in topics[:-1])))
+
+
+def listener_grant(ros2: Any) -> Grant:
+    """A dashboard or recorder: read ``/diagnostics`` and each arm's ``health_diagnosis``."""
+    from robohealth_mj.ros2.node import DIAGNOSTICS_TOPIC
+
+    arms = _arm_topics(ros2)
+    return Grant(subscribe=(DIAGNOSTICS_TOPIC, *(topics[-1] for topics in arms.values())))
+
+
+def everything_grant(ros2: Any = None) -> Grant:
+    """sros2's default for a new enclave: every topic, both ways."""
+    return Grant.everything()
+
+
+def topics_grant(publish: Sequence[str] = (), subscribe: Sequence[str] = ()) -> Any:
+    """The topics named (ROS names, ``*`` any characters), as a grant builder."""
+
+    def build(ros2: Any = None) -> Grant:
+        names = [*publish, *subscribe]
+        if not names:
+            raise InputError("grant=topics needs grant.publish=[...] or grant.subscribe=[...]")
+        for name in names:
+            if not str(name).startswith("/"):
+                raise InputError(
+                    f"grant: topic {name!r} must be a ROS name such as /arm1/joint_states"
+                )
+        return Grant(publish=tuple(map(str, publish)), subscribe=tuple(map(str, subscribe)))
+
+    return build
