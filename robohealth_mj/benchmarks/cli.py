@@ -83,7 +83,10 @@ def main(argv: list[str] | None = None) -> None:
     ros2.add_argument("--data", default="outputs/corpus/quick/heldout_seed900")
     ros2.add_argument("--arms", type=int, nargs="+", default=[10, 25, 50])
     ros2.add_argument("--seconds", type=float, default=20.0)
-    ros2.add_argument("--layouts", nargs="+", default=["per_sensor", "aggregated"])
+    ros2.add_argument(
+        "--layouts", nargs="+", default=["per_sensor", "aggregated"],
+        choices=["per_sensor", "aggregated", "ur_driver"],
+    )  # fmt: skip
     ros2.add_argument(
         "--monitors", type=int, nargs="+", default=[1],
         help="monitor processes sharing the arms (ros2.partition=k/n), one row per count",
@@ -91,6 +94,10 @@ def main(argv: list[str] | None = None) -> None:
     ros2.add_argument(
         "--health-hz", type=float, default=20.0, help="each arm's /health_diagnosis rate"
     )
+    ros2.add_argument(
+        "--driver-hz", type=float, default=500.0,
+        help="ur_driver layout: the controller's rate (joint and controller states per second)",
+    )  # fmt: skip
     ros2.add_argument(
         "--graphs", nargs="+", default=["open"], choices=["open", "secured"],
         help="open and/or SROS2-secured graph (secured: a keystore made for the run; needs the "
@@ -155,7 +162,7 @@ def main(argv: list[str] | None = None) -> None:
         with one_line_errors("bench"):
             bench_ros2(args.model, args.data, args.arms, args.seconds, args.layouts,
                        args.monitors, args.health_hz, args.diagnose_wait_s,
-                       args.graphs)  # fmt: skip
+                       args.graphs, args.driver_hz)  # fmt: skip
     elif args.what in ("streams", "soak"):
         from robohealth_mj.benchmarks.fleet import bench_fleet, bench_soak
         from robohealth_mj.common.errors import one_line_errors

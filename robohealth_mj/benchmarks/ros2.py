@@ -3,7 +3,9 @@ latency from a robot's publish to the diagnosis on ``/diagnostics``.
 
 Publishers run in a child process (replaying a recording, stamps set to the wall clock at publish,
 so the monitor reads each sample's age directly); the monitors run in their own processes, each
-a share of the arms (scale-out: ``--monitors 1 2``). CPU is reported apart
+a share of the arms (scale-out: ``--monitors 1 2``). ``--layouts ur_driver``: the UR driver's
+topics at the controller's rate (``--driver-hz``, 500), 25 joint and 25 controller states an arm
+per model tick. CPU is reported apart
 for each side (process time over wall time, in cores). ``--graphs open secured``: each row on an
 open graph and on an SROS2-secured one (a keystore made for the run: the robot's and the
 monitor's enclaves with their grants, the default governance: encrypted and signed), one after
@@ -19,10 +21,13 @@ from typing import Any
 
 import numpy as np
 
+# messages an arm sends per 20 Hz tick (ur_driver: per controller cycle, joint and controller state)
+MESSAGES_PER_TICK = {"per_sensor": 15, "aggregated": 2, "joints": 3, "ur_driver": 2}
+
 
 def _publisher(
     domain: int, arms: int, samples: list, seconds: float, layout: str, ready, go, out,
-    security=None,
+    security=None, driver_hz: float = 500.0,
 ) -> None:  # fmt: skip
     from robohealth_mj.ros2.bus import Bus, BusConfig
     from robohealth_mj.ros2.node import ArmPublisher
@@ -36,13 +41,21 @@ def _publisher(
     go.wait()
     cpu0, wall0 = time.process_time(), time.perf_counter()
     ticks = int(seconds * 20)
-    for tick in range(ticks):
-        due = wall0 + tick / 20.0
+    # the UR driver's layout: joint states and controller states at the controller's rate
+    # (driver_hz), stamped on the controller's schedule as a driver stamps its cycles (a late
+    # publisher then shows as latency, and the monitor's tick grid holds `ticks` ticks); the
+    # others: one sample's messages a tick, stamped when sent
+    driver = layout == "ur_driver"
+    per_tick = max(1, round(driver_hz / 20)) if driver else 1
+    epoch0 = time.time()
+    for step in range(ticks * per_tick):
+        due = wall0 + step / (20.0 * per_tick)
         delay = due - time.perf_counter()
         if delay > 0:
             time.sleep(delay)
-        base = samples[tick % len(samples)]
-        sample = base.__class__("bench", tick, time.time(), base.x, base.fault, base.segment)
+        base = samples[step // per_tick % len(samples)]
+        stamp = epoch0 + step / (20.0 * per_tick) if driver else time.time()
+        sample = base.__class__("bench", step, stamp, base.x, base.fault, base.segment)
         built = pubs[0].serialized([m for _, m in pubs[0].messages(sample, topics)])  # stamped now
         for pub in pubs:
             pub.publish_serialized(built)
@@ -71,9 +84,10 @@ def _monitor(
         latencies.append(time.time() - sample.t)
 
     bus = Bus(BusConfig(domain_id=domain, interface="127.0.0.1", depth=50, security=security))
+    names = "ur_driver" if layout == "ur_driver" else "schema"  # as the publisher names joints
     node = MonitorNode(bus, ModelRuntime(model), arms, on_diagnosis=on_diagnosis, layout=layout,
-                       health_diagnosis_hz=health_hz,
-                       diagnose_wait_s=diagnose_wait_s)  # fmt: skip
+                       health_diagnosis_hz=health_hz, diagnose_wait_s=diagnose_wait_s,
+                       joint_names=names)  # fmt: skip
     ready.set()
     go.wait()
     cpu0, wall0 = time.process_time(), time.perf_counter()
@@ -94,7 +108,7 @@ def _monitor(
 def run_once(
     model: str, samples: list, arms: int, seconds: float, domain: int, layout: str,
     monitors: int = 1, health_hz: float = 20.0, diagnose_wait_s: float = 0.02,
-    security: dict | None = None,
+    security: dict | None = None, driver_hz: float = 500.0,
 ) -> dict[str, Any]:  # fmt: skip
     """Publishers in one child process; ``monitors`` monitor processes, each a stable-hash
     share of the arms (as ``ros2.partition=k/n`` splits them); CPU per side in cores.
@@ -120,7 +134,7 @@ def run_once(
     children.append(ctx.Process(
         target=_publisher,
         args=(domain, arms, samples, seconds, layout, publisher_ready, go, out,
-              security.get("robot")),
+              security.get("robot"), driver_hz),
     ))  # fmt: skip
     for child in children:
         child.start()
@@ -133,6 +147,7 @@ def run_once(
     for child in children:
         child.join(10)
     got = sum(p["diagnosed"] for p in parts)
+    rate = driver_hz if layout == "ur_driver" else 20.0  # each arm's messages per second
     latencies = [v for p in parts for v in p["latencies"]]
     lat = np.array(latencies) * 1e3 if latencies else np.array([np.nan])
     phases: dict[str, float] = {}
@@ -142,7 +157,7 @@ def run_once(
     return {
         "arms": arms,
         "monitors": monitors,
-        "messages_per_s": arms * (15 if layout == "per_sensor" else 2) * 20,
+        "messages_per_s": round(arms * MESSAGES_PER_TICK[layout] * rate),
         "published_samples": published["ticks"] * arms,
         "diagnosed": got,
         "lost": published["ticks"] * arms - got,
@@ -178,7 +193,7 @@ def secured_graph(root: Any, domain: int, arms: int, layout: str) -> dict[str, A
 def bench_ros2(
     model: str, data: str, arms_list: list[int], seconds: float, layouts: list[str],
     monitors: list[int] | None = None, health_hz: float = 20.0, diagnose_wait_s: float = 0.02,
-    graphs: list[str] | None = None,
+    graphs: list[str] | None = None, driver_hz: float = 500.0,
 ) -> list[dict]:  # fmt: skip
     from robohealth_mj.data.arrays import resolve_recordings
     from robohealth_mj.data.read import read_samples
@@ -200,7 +215,7 @@ def bench_ros2(
             domain = next(domains)
             security = secured_graph(root, domain, arms, layout) if graph == "secured" else None
             r = run_once(model, samples, arms, seconds, domain, layout, n, health_hz,
-                         diagnose_wait_s, security)  # fmt: skip
+                         diagnose_wait_s, security, driver_hz)  # fmt: skip
             r["layout"], r["graph"] = layout, graph
             rows.append(r)
             _print_row(r, n)

@@ -25,6 +25,7 @@ Every sample is unlabelled (a real arm has no ground truth) and numbered by its 
 
 from __future__ import annotations
 
+import struct
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -36,6 +37,7 @@ from robohealth_mj.bags.joints import joint_order
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.jsonl import node_features
 from robohealth_mj.ros2.assembly import Assembled, header_stamp_ns
+from robohealth_mj.ros2.cdr import decode, stamp_ns_at, undecodable
 from robohealth_mj.schema import (
     SENSOR_FEATURES,
     STATE_CHANNELS,
@@ -133,13 +135,7 @@ class DriverAssembler:
             return out
         last = self.last_state if topic == self.joint_states else self.last_error
         if last is not None and stamp <= last[0]:
-            if stamp == last[0] and msg == last[1]:
-                out.duplicates += 1
-            else:
-                out.problems.append(
-                    f"topic '{topic}': stamp {stamp / 1e9:.6f} s is not after the last message "
-                    f"({last[0] / 1e9:.6f} s): stamps went backwards"
-                )
+            self._not_after(topic, stamp, msg == last[1], last[0], out)
             return out
         try:
             if topic == self.joint_states:
@@ -152,6 +148,55 @@ class DriverAssembler:
             out.problems.append(f"topic '{topic}' at stamp {stamp / 1e9:.6f} s: {exc}")
         self._drain(out, settle=False)
         return out
+
+    def add_serialized(self, topic: str, kind: type, buffers: list[bytes], out: Assembled) -> None:
+        """Take one topic's messages as they came off the wire, into ``out``, decoding only
+        what a tick uses. At 500 Hz the driver sends 25 joint states and 25 controller states
+        per 20 Hz tick and a tick reads one of each: a joint state between ticks is passed
+        over from its stamp alone (8 bytes), and a controller state is kept as bytes until a
+        tick takes it (:meth:`_held_error`). A malformed message a tick never uses is
+        therefore not reported."""
+        joint_states = topic == self.joint_states
+        for buf in buffers:
+            try:
+                stamp = stamp_ns_at(buf)
+            except struct.error:
+                out.problems.append(f"topic '{topic}': {len(buf)} bytes, too short for a header")
+                continue
+            last = self.last_state if joint_states else self.last_error
+            if last is not None and stamp <= last[0]:
+                self._not_after(topic, stamp, buf == last[1], last[0], out)
+                continue
+            if not joint_states:
+                self.last_error = (stamp, buf)
+                self.errors.append((stamp, (kind, buf)))  # decoded when a tick takes it
+                self.silent = False
+            else:
+                self.last_state = (stamp, buf)
+                if self._between_ticks(stamp):
+                    continue
+                try:
+                    self._joint_state(stamp, decode(kind, buf), out)
+                except _Problem as exc:
+                    out.problems.append(f"topic '{topic}' at stamp {stamp / 1e9:.6f} s: {exc}")
+                except Exception as exc:  # bytes no decoder reads: this arm's bad input
+                    out.problems.append(f"topic '{topic}': {undecodable(kind, exc)}")
+            self._drain(out, settle=False)
+
+    def _not_after(self, topic: str, stamp: int, same: bool, last: int, out: Assembled) -> None:
+        """A message not newer than the topic's last: a re-delivery, or stamps going back."""
+        if stamp == last and same:
+            out.duplicates += 1
+        else:
+            out.problems.append(
+                f"topic '{topic}': stamp {stamp / 1e9:.6f} s is not after the last message "
+                f"({last / 1e9:.6f} s): stamps went backwards"
+            )
+
+    def _between_ticks(self, stamp: int) -> bool:
+        """Whether a joint state falls between two ticks: the driver publishes faster than the
+        model reads."""
+        return self.next_tick is not None and stamp < self.next_tick - self.period_ns // 100
 
     def add_all(self, topic: str, messages: list[Any], out: Assembled) -> None:
         """Take one topic's messages in order, into ``out``."""
@@ -182,8 +227,8 @@ class DriverAssembler:
         return columns
 
     def _joint_state(self, stamp: int, msg: Any, out: Assembled) -> None:
-        if self.next_tick is not None and stamp < self.next_tick - self.period_ns // 100:
-            return  # between ticks: the driver publishes faster than the model reads
+        if self._between_ticks(stamp):
+            return
         pos, vel, effort = self._columns(msg, msg.name, msg, ("position", "velocity", "effort"))
         if self.scale is not None:
             effort = effort * self.scale
@@ -199,15 +244,31 @@ class DriverAssembler:
             out.samples.append(self._sample(stamp, state))
 
     def _tracking_error(self, stamp: int, msg: Any) -> None:
-        (error,) = self._columns(msg, msg.joint_names, msg.error, ("positions",))
-        self.errors.append((stamp, -error))
+        self.errors.append((stamp, self._error_of(msg)))
         self.silent = False
 
+    def _error_of(self, msg: Any) -> np.ndarray:
+        """A controller state's tracking error as this project reads it (measured - target)."""
+        (error,) = self._columns(msg, msg.joint_names, msg.error, ("positions",))
+        return -error
+
     def _held_error(self, tick: int) -> np.ndarray | None:
-        """The controller's tracking error at ``tick``: its last state at or before it."""
-        for stamp, error in reversed(self.errors):
+        """The controller's tracking error at ``tick``: its last state at or before it
+        (decoded here where it came as bytes)."""
+        for k in range(len(self.errors) - 1, -1, -1):
+            stamp, error = self.errors[k]
             if stamp <= tick:
-                return error if tick - stamp <= self.max_age_ns else None
+                if tick - stamp > self.max_age_ns:
+                    return None
+                if isinstance(error, tuple):  # (kind, bytes): the first tick to use it
+                    kind, buf = error
+                    try:
+                        message = decode(kind, buf)
+                    except Exception as exc:
+                        raise _Problem(undecodable(kind, exc)) from None
+                    error = self._error_of(message)
+                    self.errors[k] = (stamp, error)
+                return error
         return None
 
     def _drain(self, out: Assembled, settle: bool) -> None:
@@ -216,7 +277,12 @@ class DriverAssembler:
             tick, state = self.pending[0]
             if newest is not None and newest >= tick:  # nothing nearer can come
                 self.pending.popleft()
-                error = self._held_error(tick)
+                try:
+                    error = self._held_error(tick)
+                except _Problem as exc:  # the state this tick takes is malformed: dropped
+                    out.problems.append(f"topic '{self.controller_state}' at tick "
+                                        f"{tick / 1e9:.6f} s: {exc}")  # fmt: skip
+                    continue
                 if error is not None:  # else too old to trust: the tick is dropped
                     state[:, _POS_ERROR] = error
                     out.samples.append(self._sample(tick, state))

@@ -22,7 +22,7 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.ros2 import layout_sensing
 from robohealth_mj.ros2.assembly import ArmAssembler, Assembled
 from robohealth_mj.ros2.bus import Bus, ReadySet
-from robohealth_mj.ros2.cdr import decode_all, encode_diagnostic_array, take_raw
+from robohealth_mj.ros2.cdr import encode_diagnostic_array, take_raw
 from robohealth_mj.ros2.driver import DriverAssembler, DriverConfig, DriverMessages
 from robohealth_mj.ros2.idl import CONTROLLER_STATES, TYPES, IdlStore
 from robohealth_mj.schema import GraphSample
@@ -224,16 +224,17 @@ class MonitorNode:
         self._waiting_since: float | None = None
         self.keep_diagnoses, self.on_diagnosis = keep_diagnoses, on_diagnosis
         # where the monitor's time goes (the benchmark reports it): take (the DDS take),
-        # decode (CDR), assemble, diagnose (runtime), publish (the diagnoses' writes)
+        # assemble (with the decoding of what a sample needs), diagnose (runtime), publish (the
+        # diagnoses' writes)
         self.seconds: dict[str, float] = dict.fromkeys(
-            ("take", "decode", "assemble", "diagnose", "publish"), 0.0
+            ("take", "assemble", "diagnose", "publish"), 0.0
         )
         self._publishing = 0.0
         self.factory = MessageFactory(IdlStore())
         self.arms: dict[str, ArmState] = {}
         self.reported: list[tuple[str, str]] = []  # (arm, problem) of the last /diagnostics
         self.diagnosis_writers: dict[str, Any] = {}
-        self._taps: list[tuple[str, str, type, Any, bool]] = []  # every reader, arm by arm
+        self._taps: list[tuple[str, str, type, Any]] = []  # every reader, arm by arm
         for arm in arms:
             names = arm_topics(arm, topics, namespace)
             joints = arm_joint_names(joint_names, tf_prefix.format(arm=arm))
@@ -247,9 +248,9 @@ class MonitorNode:
                                          joints=joints)  # fmt: skip
             readers = [(t, kinds[t], bus.reader(t, kinds[t])) for t in assembler.topic_names()]
             self.arms[arm] = ArmState(assembler, readers)
-            # the bag layouts' assembler reads the bytes (byte templates); the driver's, objects
-            raw = isinstance(assembler, ArmAssembler)
-            self._taps += [(arm, topic, kind, reader, raw) for topic, kind, reader in readers]
+            # every assembler reads the bytes: the bag layouts' by byte templates, the driver's
+            # decoding only the messages a tick uses
+            self._taps += [(arm, topic, kind, reader) for topic, kind, reader in readers]
             self.diagnosis_writers[arm] = bus.writer(names.health_diagnosis, TYPES[
                 "diagnostic_msgs/msg/DiagnosticArray"])  # fmt: skip
         self.diagnostics = bus.writer(
@@ -266,7 +267,7 @@ class MonitorNode:
         submitted: list[tuple[str, GraphSample]] = []
         taken_by_arm: dict[str, Assembled] = {}
         for index in ready:
-            arm, topic, kind, reader, serialized = self._taps[index]
+            arm, topic, kind, reader = self._taps[index]
             state = self.arms[arm]
             out = taken_by_arm.get(arm)
             if out is None:
@@ -275,15 +276,8 @@ class MonitorNode:
             raw = take_raw(reader, max_per_reader)
             t1 = clock()
             self.seconds["take"] += t1 - t0
-            if serialized:  # decoding is part of assembly (only a changed layout is decoded)
-                state.assembler.add_serialized(topic, kind, raw, out)
-            else:
-                taken, undecodable = decode_all(kind, raw)
-                td = clock()
-                self.seconds["decode"] += td - t1
-                t1 = td
-                out.problems += [f"topic '{topic}': {problem}" for problem in undecodable]
-                state.assembler.add_all(topic, taken, out)
+            # decoding is part of assembly (only what a sample needs is decoded)
+            state.assembler.add_serialized(topic, kind, raw, out)
             self.seconds["assemble"] += clock() - t1
         t1 = clock()
         for arm, out in taken_by_arm.items():

@@ -155,6 +155,55 @@ def test_driver_topics_at_500_hz_become_the_model_s_ticks_with_the_tracking_erro
     assert problems == [] and [s.sample_index for s in got] == [0, 1, 2, 5, 6, 7, 10]  # 11 waits
 
 
+def test_the_bytes_path_at_500_hz_gives_the_same_ticks_decoding_one_message_of_each_per_tick(
+    monkeypatch,
+):
+    """As the monitor reads the driver (``add_serialized``, bytes off the wire): the same
+    samples as the decoded path, with only the joint state and the controller state each tick
+    uses decoded (at 500 Hz, one of 25 of each); a malformed controller state that a tick takes
+    marks the arm and drops that tick, one that no tick takes is never read."""
+    import robohealth_mj.ros2.driver as driver
+    from robohealth_mj.ros2.assembly import Assembled
+
+    samples = _samples(12)
+    stream = _driver_stream(samples, controller_hz=500)
+    kinds = {"/js": JointState, "/cs": CONTROLLER_STATES["jazzy"]}
+    decoded, decode = [], driver.decode
+    monkeypatch.setattr(
+        driver, "decode", lambda kind, buf: decoded.append(kind) or decode(kind, buf)
+    )
+
+    def run(buffers):
+        assembler = DriverAssembler("left", "/js", "/cs", UR, DriverConfig(tracking=True))
+        out = Assembled()
+        for topic, data in buffers:
+            assembler.add_serialized(topic, kinds[topic], [data], out)
+        out.extend(assembler.settle())
+        return out
+
+    buffers = [(topic, msg.serialize()) for topic, msg in stream]
+    out = run(buffers)
+    reference, _, _ = _run(DriverAssembler("left", "/js", "/cs", UR, DriverConfig()), stream)
+    assert out.problems == [] and len(out.samples) == len(reference) == 12
+    for a, b in zip(out.samples, reference, strict=True):
+        np.testing.assert_array_equal(a.x, b.x)
+        assert a.sample_index == b.sample_index and a.stamp_ns == b.stamp_ns
+    assert decoded.count(JointState) == 12  # of 300 joint states
+    assert len(decoded) - 12 <= 12 + 1  # of 300 controller states: one a tick (and the last)
+    # a garbled controller state: the one tick 3 takes (at its instant), and one between ticks
+    tick3 = round(samples[3].t * 1e9)
+    garbled = []
+    for topic, data in buffers:
+        stamp = int.from_bytes(data[4:8], "little") * 10**9 + int.from_bytes(data[8:12], "little")
+        if topic == "/cs" and stamp in (tick3, tick3 + 10_000_000):
+            data = data[:40]  # cut short: no decoder reads it
+        garbled.append((topic, data))
+    out = run(garbled)
+    assert [s.sample_index for s in out.samples] == [k for k in range(12) if k != 3]
+    assert len(out.problems) == 1 and "topic '/cs' at tick" in out.problems[0]
+    assert "undecodable JazzyControllerState" in out.problems[0]
+
+
 def test_a_seven_joint_ros2_control_arm_is_assembled_by_its_drivers_names():
     """franka_ros2's FR3 (any ros2_control driver): seven joints found by the preset's names,
     the samples on the arm's seven-joint graph; ``joint_names=auto`` takes the model's arm's
