@@ -13,21 +13,21 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.ros2.keystore import Grant
 
 
-def _arm_topics(ros2: Any) -> dict[str, list[str]]:
-    """Each configured arm's topics in the configured layout (as the monitor and robot open
-    them), and where its diagnosis is published."""
+def _arm_topics(ros2: Any) -> tuple[list[str], list[str]]:
+    """The configured arms' topics in the configured layout (as the monitor and robot open
+    them), and where their diagnoses are published."""
     from robohealth_mj.ros2.live import arm_names, layout_options
     from robohealth_mj.ros2.node import arm_kinds, arm_topics
 
     options = layout_options(ros2)
-    out = {}
+    samples, diagnoses = [], []
     for arm in arm_names(ros2):
         names = arm_topics(arm, None, options["namespace"])
-        kinds = arm_kinds(names, arm, options["layout"], options["driver"], options["namespace"])
-        out[arm] = [*kinds, names.health_diagnosis]
-    if not out:
+        samples += arm_kinds(names, arm, options["layout"], options["driver"], options["namespace"])
+        diagnoses.append(names.health_diagnosis)
+    if not diagnoses:
         raise InputError("ros2.arms: no arms to grant (ros2.arms=[...] or ros2.count=N)")
-    return out
+    return list(dict.fromkeys(samples)), list(dict.fromkeys(diagnoses))
 
 
 def monitor_grant(ros2: Any) -> Grant:
@@ -35,25 +35,23 @@ def monitor_grant(ros2: Any) -> Grant:
     ``health_diagnosis``; nothing else."""
     from robohealth_mj.ros2.node import DIAGNOSTICS_TOPIC
 
-    arms = _arm_topics(ros2)
-    read = [t for topics in arms.values() for t in topics[:-1]]
-    write = [DIAGNOSTICS_TOPIC, *(topics[-1] for topics in arms.values())]
-    return Grant(publish=tuple(dict.fromkeys(write)), subscribe=tuple(dict.fromkeys(read)))
+    samples, diagnoses = _arm_topics(ros2)
+    return Grant(publish=(DIAGNOSTICS_TOPIC, *diagnoses), subscribe=tuple(samples))
 
 
 def robot_grant(ros2: Any) -> Grant:
     """A robot (``python -m robohealth_mj.robot``, or a driver's stand-in): write its arms'
     topics; read nothing."""
-    arms = _arm_topics(ros2)
-    return Grant(publish=tuple(dict.fromkeys(t for topics in arms.values() for t in topics[:-1])))
+    samples, _ = _arm_topics(ros2)
+    return Grant(publish=tuple(samples))
 
 
 def listener_grant(ros2: Any) -> Grant:
     """A dashboard or recorder: read ``/diagnostics`` and each arm's ``health_diagnosis``."""
     from robohealth_mj.ros2.node import DIAGNOSTICS_TOPIC
 
-    arms = _arm_topics(ros2)
-    return Grant(subscribe=(DIAGNOSTICS_TOPIC, *(topics[-1] for topics in arms.values())))
+    _, diagnoses = _arm_topics(ros2)
+    return Grant(subscribe=(DIAGNOSTICS_TOPIC, *diagnoses))
 
 
 def everything_grant(ros2: Any = None) -> Grant:
