@@ -25,7 +25,7 @@ from torch import nn
 
 from robohealth_mj import schema
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.models.boosting import train_early_stopped
+from robohealth_mj.models.boosting import booster_text, train_early_stopped
 from robohealth_mj.models.severity_levels import SeverityLevels
 from robohealth_mj.models.statistics import window_statistics
 
@@ -34,9 +34,7 @@ def _booster_bytes(booster: Any | None) -> torch.Tensor:
     """A booster (or :class:`SeverityLevels`) as a uint8 buffer, so checkpoints hold it."""
     if booster is None:
         return torch.zeros(0, dtype=torch.uint8)
-    text = (
-        booster.to_bytes() if hasattr(booster, "to_bytes") else booster.model_to_string().encode()
-    )
+    text = booster.to_bytes() if hasattr(booster, "to_bytes") else booster_text(booster)
     return torch.frombuffer(bytearray(text), dtype=torch.uint8).clone()
 
 

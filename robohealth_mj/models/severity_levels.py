@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from robohealth_mj.models.boosting import train_early_stopped
+from robohealth_mj.models.boosting import booster_text, train_early_stopped
 
 
 def severity_levels(severity: np.ndarray, max_levels: int) -> np.ndarray:
@@ -127,7 +127,7 @@ class SeverityLevels:
 
     def to_bytes(self) -> bytes:
         groups = {
-            f"{c},{j}": (m.tolist() if isinstance(m, np.ndarray) else m.model_to_string())
+            f"{c},{j}": (m.tolist() if isinstance(m, np.ndarray) else booster_text(m).decode())
             for (c, j), m in self.groups.items()
         }
         return json.dumps({"levels": self.levels.tolist(), "groups": groups}).encode()
