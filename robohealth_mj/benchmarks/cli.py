@@ -107,6 +107,12 @@ def main(argv: list[str] | None = None) -> None:
         "--diagnose-wait-s", type=float, default=0.02,
         help="how long a completed sample waits for the other arms' (ros2.diagnose_wait_s)",
     )  # fmt: skip
+    ros2.add_argument(
+        "--kill", type=int, default=0, choices=[0, 1],
+        help="1: a monitor group under kill and restart instead (--monitors N, --arms A: the "
+        "first of each; aggregated layout): recovery, double diagnosis and loss per cycle",
+    )  # fmt: skip
+    ros2.add_argument("--cycles", type=int, default=10, help="--kill 1: kill/restart cycles")
     for p, seconds in ((streams, 30.0), (soak, 60.0)):
         p.add_argument("--model", default=headline)
         p.add_argument("--data", nargs="+", default=["outputs/corpus/standard/heldout_seed900"])
@@ -160,6 +166,11 @@ def main(argv: list[str] | None = None) -> None:
         from robohealth_mj.common.errors import one_line_errors
 
         with one_line_errors("bench"):
+            if args.kill:
+                from robohealth_mj.benchmarks.failover import bench_failover
+
+                bench_failover(args.model, args.data, args.monitors[0], args.arms[0], args.cycles)
+                return
             bench_ros2(args.model, args.data, args.arms, args.seconds, args.layouts,
                        args.monitors, args.health_hz, args.diagnose_wait_s,
                        args.graphs, args.driver_hz)  # fmt: skip

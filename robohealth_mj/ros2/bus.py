@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import ctypes
 import os
+import time
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
@@ -243,6 +244,13 @@ class Bus:
             raise DDSException(ret, f"Occurred while reading the matched status of {writer!r}")
         return int(status.current_count)
 
+    @staticmethod
+    def delete(entity: Any) -> None:
+        """Delete a reader, writer, condition or waitset now (with what it holds). The binding
+        keeps every entity in a class-wide table until its own deletion runs, so dropping the
+        last reference is not enough."""
+        entity.__del__()
+
     def close(self) -> None:
         """Delete the participant (and with it every reader, writer and topic)."""
         self._topics.clear()
@@ -284,7 +292,17 @@ class ReadySet:
         from cyclonedds.core import DDSException
 
         n = len(self._conditions)
+        if not n:  # no readers (a monitor whose arms all went to others): nothing to wait on
+            if timeout_s > 0:
+                time.sleep(timeout_s)
+            return []
         got = self._waitset._waitset_wait(self._waitset._ref, self._out, n, int(timeout_s * 1e9))
         if got < 0:
             raise DDSException(got, "Occurred while waiting for readers")
         return sorted(self._triggered[i] - 1 for i in range(min(got, n)))
+
+    def close(self) -> None:
+        """Delete the waitset and its read conditions (the readers stay)."""
+        for entity in (self._waitset, *self._conditions):
+            Bus.delete(entity)
+        self._conditions = []

@@ -32,11 +32,14 @@ def _arm_topics(ros2: Any) -> tuple[list[str], list[str]]:
 
 def monitor_grant(ros2: Any) -> Grant:
     """The monitor: read every arm's topics; write ``/diagnostics`` and each arm's
-    ``health_diagnosis``; nothing else."""
+    ``health_diagnosis``; in a monitor group (``ros2.group.enable``) also write and read the
+    group's heartbeats; nothing else."""
+    from robohealth_mj.ros2.group import GROUP_TOPIC
     from robohealth_mj.ros2.node import DIAGNOSTICS_TOPIC
 
     samples, diagnoses = _arm_topics(ros2)
-    return Grant(publish=(DIAGNOSTICS_TOPIC, *diagnoses), subscribe=tuple(samples))
+    group = (GROUP_TOPIC,) if (ros2.get("group") or {}).get("enable") else ()
+    return Grant(publish=(DIAGNOSTICS_TOPIC, *diagnoses, *group), subscribe=(*samples, *group))
 
 
 def robot_grant(ros2: Any) -> Grant:

@@ -14,6 +14,7 @@ from typing import Any
 
 from omegaconf import DictConfig
 
+from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.ros2 import require_dds
 from robohealth_mj.schema import GraphSample
@@ -106,25 +107,35 @@ def run_monitor(
     ``tracking``: the model reads the tracking error (``ur_driver``: await the controller)."""
     require_dds()
     from robohealth_mj.ros2.bus import Bus
+    from robohealth_mj.ros2.group import MonitorGroup, group_config
     from robohealth_mj.ros2.node import MonitorNode, poll_paced
 
+    grouped = group_config(cfg.get("group"))
+    if grouped is not None and cfg.partition:
+        raise InputError("ros2.group.enable=true shares the arms itself: drop ros2.partition "
+                         f"({cfg.partition!r}), the static split")  # fmt: skip
     arms = arm_names(cfg)
     if not arms:
         raise ValueError("ros2: no arms in this process's partition")
     config = bus_config(cfg)
     bus = Bus(config)
-    node = MonitorNode(bus, runtime, arms, require_truth=bool(cfg.require_truth),
+    group = MonitorGroup(bus, grouped, arms) if grouped is not None else None
+    watched = group.discover() if group is not None else arms
+    node = MonitorNode(bus, runtime, watched, require_truth=bool(cfg.require_truth),
                        stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
                        health_diagnosis_hz=float(cfg.get("health_diagnosis_hz", 20.0)),
                        tick_hz=float(cfg.get("tick_hz", 20.0)),
                        diagnose_wait_s=float(cfg.get("diagnose_wait_s", 0.02)),
+                       member=grouped.member if grouped is not None else None,
                        **layout_options(cfg, tracking, model_arm(runtime)))  # fmt: skip
     started = time.monotonic()
     last_report = started
     secured = f", secured as {config.security.enclave}" if config.security else ""
-    print(f"ros2 monitor: {len(arms)} arms on domain {cfg.domain_id}{secured} "
-          f"({', '.join(arms[:5])}{' …' if len(arms) > 5 else ''}); Ctrl-C to stop",
+    print(f"ros2 monitor: {len(watched)} arms on domain {cfg.domain_id}{secured} "
+          f"({', '.join(watched[:5])}{' …' if len(watched) > 5 else ''}); Ctrl-C to stop",
           flush=True)  # fmt: skip
+    if group is not None:
+        _say_group(group, node)
     with stop_on_signals() as stop:
         try:
             while not stop.is_set():
@@ -132,12 +143,17 @@ def run_monitor(
                 if duration_s and now - started >= duration_s:
                     break
                 poll_paced(node, float(cfg.poll_s))  # what arrived in a period, in one go
+                if group is not None and (wanted := group.update()) != list(node.arms):
+                    node.set_arms(wanted)  # a member came or went
+                    _say_group(group, node)
                 if now - last_report >= float(cfg.diagnostics_period_s):
                     node.publish_diagnostics(time.time())
                     for arm, problem in node.reported:  # as it happens, not only at the end
                         print(f"{arm}: {problem}", flush=True)
                     last_report = now
         finally:
+            if group is not None:
+                group.leave()  # the others take this monitor's arms now, not after a timeout
             node.publish_diagnostics(time.time())  # the last word on every arm
             bus.close()
     return {
@@ -148,8 +164,14 @@ def run_monitor(
             "duplicates": s.duplicates,
             "last_problem": s.last_problem,
         }
-        for arm, s in node.arms.items()
+        for arm, s in {**node.released, **node.arms}.items()
     }
+
+
+def _say_group(group: Any, node: Any) -> None:
+    members = group.members()
+    print(f"ros2 group: {group.me} watches {len(node.arms)} of {len(group.arms)} arms; members "
+          f"{', '.join(members)}", flush=True)  # fmt: skip
 
 
 def wait_for_subscribers(writers: list[Any], timeout_s: float) -> bool:

@@ -204,10 +204,12 @@ class MonitorNode:
         health_diagnosis_hz: float = 20.0,
         diagnose_wait_s: float = 0.02,
         tick_hz: float = 20.0,
+        member: str | None = None,
     ) -> None:
         """``health_diagnosis_hz``: each arm's ``/health_diagnosis`` at most this often (every
         diagnosis at ``tick_hz``, the model's rate; less saves the monitor's publishing time at
-        many arms).
+        many arms). ``member``: this monitor's name in a monitor group (``/diagnostics`` then
+        says which monitor watches each arm; :meth:`set_arms` moves arms in and out).
         ``joint_names`` (a preset of ``conf/joint_names.yaml`` or six names) and ``tf_prefix``
         (``{arm}`` is the arm's name) say what each arm's JointState messages call its joints;
         ``namespace`` where its topics live; ``driver`` the UR driver's side (``ur_driver``).
@@ -232,31 +234,74 @@ class MonitorNode:
         self._publishing = 0.0
         self.factory = MessageFactory(IdlStore())
         self.arms: dict[str, ArmState] = {}
+        self.released: dict[str, ArmState] = {}  # arms another monitor took (their counts)
         self.reported: list[tuple[str, str]] = []  # (arm, problem) of the last /diagnostics
         self.diagnosis_writers: dict[str, Any] = {}
-        self._taps: list[tuple[str, str, type, Any]] = []  # every reader, arm by arm
-        for arm in arms:
-            names = arm_topics(arm, topics, namespace)
-            joints = arm_joint_names(joint_names, tf_prefix.format(arm=arm))
-            kinds = arm_kinds(names, arm, layout, driver, namespace)
-            if layout == "ur_driver":
-                assembler = DriverAssembler(arm, *kinds, joints, driver or DriverConfig())
-            else:
-                aggregated = names.aggregated if layout == "aggregated" else None
-                assembler = ArmAssembler(arm, names, require_truth=require_truth,
-                                         aggregated=aggregated, sensors=layout != "joints",
-                                         joints=joints)  # fmt: skip
-            readers = [(t, kinds[t], bus.reader(t, kinds[t])) for t in assembler.topic_names()]
-            self.arms[arm] = ArmState(assembler, readers)
-            # every assembler reads the bytes: the bag layouts' by byte templates, the driver's
-            # decoding only the messages a tick uses
-            self._taps += [(arm, topic, kind, reader) for topic, kind, reader in readers]
-            self.diagnosis_writers[arm] = bus.writer(names.health_diagnosis, TYPES[
-                "diagnostic_msgs/msg/DiagnosticArray"])  # fmt: skip
+        self.member = member
+        self._arm_options = {"topics": topics, "namespace": namespace, "layout": layout,
+                             "joint_names": joint_names, "tf_prefix": tf_prefix,
+                             "driver": driver, "require_truth": require_truth}  # fmt: skip
         self.diagnostics = bus.writer(
             DIAGNOSTICS_TOPIC, TYPES["diagnostic_msgs/msg/DiagnosticArray"]
         )
-        self.ready = ReadySet(bus, [tap[3] for tap in self._taps])
+        self.ready: ReadySet | None = None
+        self.set_arms(arms)
+
+    def _add_arm(self, arm: str) -> None:
+        """The arm's readers, assembler and diagnosis writer (its counts carried over from an
+        earlier watch)."""
+        o = self._arm_options
+        names = arm_topics(arm, o["topics"], o["namespace"])
+        joints = arm_joint_names(o["joint_names"], o["tf_prefix"].format(arm=arm))
+        kinds = arm_kinds(names, arm, o["layout"], o["driver"], o["namespace"])
+        if o["layout"] == "ur_driver":
+            assembler = DriverAssembler(arm, *kinds, joints, o["driver"] or DriverConfig())
+        else:
+            aggregated = names.aggregated if o["layout"] == "aggregated" else None
+            assembler = ArmAssembler(arm, names, require_truth=o["require_truth"],
+                                     aggregated=aggregated, sensors=o["layout"] != "joints",
+                                     joints=joints)  # fmt: skip
+        # every assembler reads the bytes: the bag layouts' by byte templates, the driver's
+        # decoding only the messages a tick uses
+        readers = [(t, kinds[t], self.bus.reader(t, kinds[t])) for t in assembler.topic_names()]
+        state = ArmState(assembler, readers)
+        if (before := self.released.pop(arm, None)) is not None:
+            for key in ("problems", "duplicates", "late", "samples"):
+                setattr(state, key, getattr(before, key))
+            state.last_problem = before.last_problem
+        self.arms[arm] = state
+        self.diagnosis_writers[arm] = self.bus.writer(names.health_diagnosis, TYPES[
+            "diagnostic_msgs/msg/DiagnosticArray"])  # fmt: skip
+
+    def _drop_arm(self, arm: str) -> None:
+        """Stop watching the arm: its readers and writer go, and its window and alarm state in
+        the runtime (another monitor starts them afresh; so does this one if it comes back)."""
+        state = self.arms.pop(arm)
+        for _, _, reader in state.readers:
+            Bus.delete(reader)
+        Bus.delete(self.diagnosis_writers.pop(arm))
+        state.readers = []
+        self.released[arm] = state
+        self._waiting.pop(arm, None)
+        self.runtime.forget(arm)
+
+    def set_arms(self, arms: Sequence[str]) -> None:
+        """Watch exactly these arms from the next poll: new ones get readers, dropped ones lose
+        theirs (a monitor group moves arms between monitors this way)."""
+        wanted = list(dict.fromkeys(arms))
+        if self.ready is not None and wanted == list(self.arms):
+            return
+        if self.ready is not None:
+            self.ready.close()
+        for arm in [a for a in self.arms if a not in wanted]:
+            self._drop_arm(arm)
+        for arm in wanted:
+            if arm not in self.arms:
+                self._add_arm(arm)
+        self._taps = [(arm, topic, kind, reader) for arm in wanted
+                      for topic, kind, reader in self.arms[arm].readers]  # fmt: skip
+        self.arms = {arm: self.arms[arm] for arm in wanted}
+        self.ready = ReadySet(self.bus, [tap[3] for tap in self._taps])
 
     def poll(self, max_per_reader: int = 256) -> int:
         """Take what has arrived; diagnose the completed samples once every arm has one, or
@@ -370,6 +415,8 @@ class MonitorNode:
             msg.message = f"bad input: {state.problem}"
         for key in ("problems", "late", "duplicates"):
             msg.values.append(self.factory.KeyValue(key=key, value=str(getattr(state, key))))
+        if self.member is not None:
+            msg.values.append(self.factory.KeyValue(key="monitor", value=self.member))
         return msg
 
     def check_writers(self) -> None:

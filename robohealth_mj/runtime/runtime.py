@@ -212,5 +212,13 @@ class ModelRuntime:
     def streams(self) -> list[str]:
         return self.fleet.streams
 
+    def forget(self, stream_id: str) -> None:
+        """Drop a stream's window, evidence and alarm state and its queued samples (a stream that
+        comes back starts afresh, as after an idle release)."""
+        slot = self.fleet.ids.get(stream_id)
+        self._queue = [(k, s) for k, s in self._queue if slot is None or k != slot]
+        if slot is not None:
+            self.fleet.release(np.array([slot]))
+
     def describe(self) -> dict[str, Any]:
         return self.fleet.describe()

@@ -13,6 +13,8 @@
 # joint: the motion fit with a per-joint score beside the scattered ones (model.anomaly_joint_scores),
 # which breaks the tie of joints a sparse placement couples alike: placements 1 and 2, full, then
 # C0 full and placement 1 retrofit (seed 42).
+# joint_more: the same form on C0 at seeds 43 and 44 (full) and 42-44 (retrofit), on placements 3
+# and 5 (full) and on placement 2 (retrofit), seed 42 where not said.
 # JOBS parallel runs of one thread each (default 2, for 2 cores).
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
@@ -70,6 +72,17 @@ for part in "$@"; do
         # no trailing blank: xargs -L would join the next line to this one
         echo "$part/$s/$name/anomaly_residual_motion_joint/seed42 variant=anomaly_residual" \
           "sensing=$s seed=42 model.coupling_fit=motion model.anomaly_joint_scores=true${place:+ $place}"
+      done | parallel_runs ;;
+    joint_more)
+      for p in C0:full::43 C0:full::44 C0:retrofit::42 C0:retrofit::43 C0:retrofit::44 \
+               seed3_m6:full:3:6:42 seed5_m4:full:5:4:42 seed2_m4:retrofit:2:4:42; do
+        IFS=: read -r name s cs cm seed <<<"$p"
+        [ -z "$seed" ] && seed=$cm && cs="" && cm=""  # C0: name:profile::seed
+        place=""
+        [ -n "$cs" ] && place="graph.coupling_seed=$cs graph.coupling_sensors=$cm"
+        part=placements; [ "$name" = C0 ] && part=default
+        echo "$part/$s/$name/anomaly_residual_motion_joint/seed$seed variant=anomaly_residual" \
+          "sensing=$s seed=$seed model.coupling_fit=motion model.anomaly_joint_scores=true${place:+ $place}"
       done | parallel_runs ;;
     summary) $PY $HERE/summarise.py --root "$ROOT" --out $HERE/results/results.md ;;
     *) echo "unknown part: $part" >&2; exit 2 ;;
