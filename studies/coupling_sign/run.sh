@@ -36,6 +36,15 @@ parallel_runs() {  # lines of "out_dir override ..." on stdin, JOBS at a time
   mkdir -p "$ROOT/logs"
   xargs -P "$JOBS" -L 1 bash -c 'run "$@"' _
 }
+joint_line() {  # "name:profile:coupling_seed:coupling_sensors:seed" -> one joint-score run line
+  local name s cs cm seed place="" part=placements
+  IFS=: read -r name s cs cm seed <<<"$1"
+  [ -n "$cs" ] && place="graph.coupling_seed=$cs graph.coupling_sensors=$cm"
+  [ "$name" = C0 ] && part=default
+  # no trailing blank: xargs -L would join the next line to this one
+  echo "$part/$s/$name/anomaly_residual_motion_joint/seed$seed variant=anomaly_residual" \
+    "sensing=$s seed=$seed model.coupling_fit=motion model.anomaly_joint_scores=true${place:+ $place}"
+}
 for part in "$@"; do
   case $part in
     fits) seeds=${FIT_SEEDS:-42}
@@ -64,25 +73,13 @@ for part in "$@"; do
           "seed=$seed model.coupling_fit=motion"
       done; done | parallel_runs ;;
     joint)
-      for p in seed1_m3:full:1:3 seed2_m4:full:2:4 C0:full: seed1_m3:retrofit:1:3; do
-        IFS=: read -r name s cs cm <<<"$p"
-        place=""
-        [ -n "$cs" ] && place="graph.coupling_seed=$cs graph.coupling_sensors=$cm"
-        part=placements; [ "$name" = C0 ] && part=default
-        # no trailing blank: xargs -L would join the next line to this one
-        echo "$part/$s/$name/anomaly_residual_motion_joint/seed42 variant=anomaly_residual" \
-          "sensing=$s seed=42 model.coupling_fit=motion model.anomaly_joint_scores=true${place:+ $place}"
+      for p in seed1_m3:full:1:3:42 seed2_m4:full:2:4:42 C0:full:::42 seed1_m3:retrofit:1:3:42; do
+        joint_line "$p"
       done | parallel_runs ;;
     joint_more)
-      for p in C0:full::43 C0:full::44 C0:retrofit::42 C0:retrofit::43 C0:retrofit::44 \
+      for p in C0:full:::43 C0:full:::44 C0:retrofit:::42 C0:retrofit:::43 C0:retrofit:::44 \
                seed3_m6:full:3:6:42 seed5_m4:full:5:4:42 seed2_m4:retrofit:2:4:42; do
-        IFS=: read -r name s cs cm seed <<<"$p"
-        [ -z "$seed" ] && seed=$cm && cs="" && cm=""  # C0: name:profile::seed
-        place=""
-        [ -n "$cs" ] && place="graph.coupling_seed=$cs graph.coupling_sensors=$cm"
-        part=placements; [ "$name" = C0 ] && part=default
-        echo "$part/$s/$name/anomaly_residual_motion_joint/seed$seed variant=anomaly_residual" \
-          "sensing=$s seed=$seed model.coupling_fit=motion model.anomaly_joint_scores=true${place:+ $place}"
+        joint_line "$p"
       done | parallel_runs ;;
     summary) $PY $HERE/summarise.py --root "$ROOT" --out $HERE/results/results.md ;;
     *) echo "unknown part: $part" >&2; exit 2 ;;
