@@ -21,7 +21,7 @@ from omegaconf import DictConfig
 from robohealth_mj.common.config import run_tool
 from robohealth_mj.common.errors import one_line_errors
 from robohealth_mj.common.threads import resolve_threads
-from robohealth_mj.runtime.monitor import monitor_policies, monitor_stream
+from robohealth_mj.runtime.monitor import decide_every, monitor_policies, monitor_stream
 from robohealth_mj.runtime.ready import resolve_file, resolve_model
 from robohealth_mj.runtime.runtime import ModelRuntime
 
@@ -46,6 +46,7 @@ def run(cfg: DictConfig) -> dict | None:
             observability=cfg.observability,
             contact=contact,
             strict=True,
+            decide_every=decide_every(cfg.decide_every),  # every k-th tick, held between
         )  # fmt: skip (strict: a model named is read here, once, or refused)
         if cfg.source != "ros2":
             return monitor_stream(cfg, runtime, alarm, evidence)

@@ -8,6 +8,7 @@
     python -m robohealth_mj.bench infer --model MODEL.onnx
     python -m robohealth_mj.bench streams [--model M] [--streams 1000] [--seconds 30]
     python -m robohealth_mj.bench streams --profile 1000 2000 [--shards 1]
+    python -m robohealth_mj.bench streams --compare HEADLINE.onnx SMALL.onnx ...
     python -m robohealth_mj.bench soak [--model M] [--streams 1000] [--seconds 60]
     python -m robohealth_mj.bench ros2 --model M [--arms 10 25 50] [--seconds 20] [--monitors 1 2]
         [--graphs open secured]
@@ -128,7 +129,18 @@ def main(argv: list[str] | None = None) -> None:
             "CPUExecutionProvider); default: CUDA where onnxruntime-gpu finds a GPU, else CPU",
         )
     streams.add_argument("--no-search", action="store_true", help="skip the stream-count search")
+    streams.add_argument(
+        "--compare", nargs="+", default=None, metavar="MODEL",
+        help="instead: MFLOP per stream-tick and sustained streams of each model (MODEL@k: "
+        "run every k-th tick of a stream, monitor decide_every=k), with ratios to the first "
+        "(the cost frontier)",
+    )  # fmt: skip
     streams.add_argument("--limit", type=int, default=8192, help="largest stream count searched")
+    streams.add_argument("--start", type=int, default=250, help="first stream count searched")
+    streams.add_argument(
+        "--decide-every", type=int, default=1,
+        help="run the model on a stream every this many ticks (monitor decide_every)",
+    )  # fmt: skip
     streams.add_argument(
         "--profile",
         type=int,

@@ -43,8 +43,12 @@ def sgemm_rate(seconds: float = 2.0, n: int = 1024) -> float:
     return _product_rate(rng.random((n, n), np.float32), rng.random((n, n), np.float32), seconds)
 
 
+MATMULS = ("MatMul", "MatMulInteger", "QLinearMatMul")  # A [.., M, K] times B [K, N]
+
+
 def onnx_flops(session_factory, model: bytes | str, feeds: dict[str, np.ndarray]) -> float:
-    """Multiply-add FLOPs (MatMul, Gemm, Einsum; 2 per multiply-add) of one run of an ONNX model
+    """Multiply-add FLOPs (MatMul, Gemm, Einsum and the int8 products MatMulInteger and
+    QLinearMatMul, counted alike; 2 per multiply-add) of one run of an ONNX model
     on ``feeds``, read off onnxruntime's own profile of that run: the shapes each node saw.
     ``session_factory(model, options)`` opens the session (so the caller picks providers)."""
     import json
@@ -74,7 +78,7 @@ def onnx_flops(session_factory, model: bytes | str, feeds: dict[str, np.ndarray]
     for e in events:
         args = e.get("args", {})
         op = args.get("op_name")
-        if e.get("cat") != "Node" or op not in ("MatMul", "Gemm", "Einsum"):
+        if e.get("cat") != "Node" or op not in ("Gemm", "Einsum", *MATMULS):
             continue
         shapes = [next(iter(d.values())) for d in args["input_type_shape"]]
         out = next(iter(args["output_type_shape"][0].values()))
@@ -87,7 +91,7 @@ def onnx_flops(session_factory, model: bytes | str, feeds: dict[str, np.ndarray]
         else:
             rows = float(np.prod(out[:-1]))
             a = shapes[0]
-            inner = float(np.prod(a)) / rows if op == "MatMul" else float(np.prod(a)) / out[0]
+            inner = float(np.prod(a)) / rows if op in MATMULS else float(np.prod(a)) / out[0]
             total += 2.0 * rows * out[-1] * inner
     return total
 

@@ -104,6 +104,38 @@ def bench_profile(args: argparse.Namespace, x: np.ndarray) -> list[dict]:
     return rows
 
 
+def bench_compare(args: argparse.Namespace, x: np.ndarray) -> list[dict]:
+    """What each of ``--compare``'s models costs per stream-tick and how many streams it
+    sustains (the search), one after the other in this run, with ratios to the first (the
+    reference): the cost frontier's deployment figures. int8 products count as FLOPs alike; a
+    model run every k-th tick (``MODEL@k``) costs 1/k of its FLOPs per stream-tick."""
+    from robohealth_mj.runtime.metadata import read_metadata
+
+    rows = []
+    for entry in args.compare:  # MODEL or MODEL@k: the model run every k-th tick of a stream
+        model, _, every = entry.partition("@")
+        k = int(every or 1)
+        print(f"\n{entry} ({read_metadata(model)['model_id']}):", flush=True)
+        found, _ = search(model, x, 100, start=args.start, shards=args.shards, chunk=args.chunk,
+                          limit=args.limit, providers=args.providers, decide_every=k)  # fmt: skip
+        rows.append({"model": entry, "mflop": model_flops(model) / 1e6 / k, "sustained": found})
+    ref = rows[0]
+    peak = sgemm_rate()
+    print(
+        f"\nsustained: the most streams with per-tick p99 <= {TICK_S * 1e3:.0f} ms (unpaced, "
+        f"{args.shards} shard threads); ratios to {ref['model']}; numpy sgemm "
+        f"{peak / 1e9:.1f} GFLOP/s on {os.cpu_count()} cores, measured after the searches\n"
+        "| model | MFLOP per stream-tick | of the reference | sustained streams | x the reference |"
+        "\n|---|---|---|---|---|"
+    )
+    for r in rows:
+        print(
+            f"| {r['model']} | {r['mflop']:.3f} | {r['mflop'] / ref['mflop']:.2f} | "
+            f"{r['sustained']} | {r['sustained'] / max(ref['sustained'], 1):.2f} |"
+        )
+    return rows
+
+
 def bench_fleet(args: argparse.Namespace) -> dict:
     """Search the sustained stream count, then a paced run at ``--streams``, then the windowed
     path at the same count; prints a markdown table."""
@@ -117,14 +149,18 @@ def bench_fleet(args: argparse.Namespace) -> dict:
     )
     if args.profile:
         return {"profile": bench_profile(args, x)}
+    if args.compare:
+        return {"compare": bench_compare(args, x)}
     found = None
     if not args.no_search:
         print("search (unpaced, 100 ticks each after the windows fill):")
-        found, _ = search(args.model, x, 100, shards=args.shards, chunk=args.chunk,
-                          limit=args.limit, providers=args.providers)  # fmt: skip
+        found, _ = search(args.model, x, 100, start=args.start, shards=args.shards,
+                          chunk=args.chunk, limit=args.limit, providers=args.providers,
+                          decide_every=args.decide_every)  # fmt: skip
         print(f"sustained: {found} streams with per-tick p99 <= {TICK_S * 1e3:.0f} ms")
     ticks = round(args.seconds / TICK_S)
-    common = {"shards": args.shards, "chunk": args.chunk, "providers": args.providers}
+    common = {"shards": args.shards, "chunk": args.chunk, "providers": args.providers,
+              "decide_every": args.decide_every}  # fmt: skip
     paced = trial(args.model, x, args.streams, ticks, paced=True, **common)
     windowed = trial(args.model, x, args.streams, 40, incremental=False, **common)
     print(

@@ -91,12 +91,14 @@ def trial(
     clock: PhaseClock | None = None,
     chunk: int = 256,
     providers: list[str] | None = None,
+    decide_every: int = 1,
 ) -> dict[str, float]:
     """A fresh runtime with ``streams`` streams: fill the windows, then time ``ticks`` ticks
     (with ``clock``, also where each tick's time went); ``providers`` as ORT names them."""
     fleet = FleetRuntime(
         model, threads=threads, shards=shards, incremental=incremental, capacity=streams,
         max_streams=streams, evidence=evidence, chunk=chunk, providers=providers,
+        decide_every=decide_every,
     )  # fmt: skip
     if fleet.engine is None:
         raise InputError(f"--model: {fleet.problem}")
@@ -121,7 +123,7 @@ def trial(
 def search(
     model: str, x: np.ndarray, ticks: int, budget_ms: float = 50.0, start: int = 250,
     limit: int = 8192, incremental: bool = True, shards: int = 2, chunk: int = 256,
-    providers: list[str] | None = None,
+    providers: list[str] | None = None, decide_every: int = 1,
 ) -> tuple[int, list[dict]]:  # fmt: skip
     """Largest stream count whose p99 step time fits the tick (in two of three trials):
     doubling, then bisection to 5 %."""
@@ -132,7 +134,7 @@ def search(
         passed = failed = 0
         while passed < 2 and failed < 2:
             row = trial(model, x, n, ticks, incremental, shards=shards, chunk=chunk,
-                        providers=providers)  # fmt: skip
+                        providers=providers, decide_every=decide_every)  # fmt: skip
             rows.append(row)
             ok = row["p99_ms"] <= budget_ms
             passed, failed = passed + ok, failed + (not ok)

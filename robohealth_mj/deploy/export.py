@@ -118,6 +118,13 @@ def heldout_recording(
     return load_checked(ckpt, files, arm), single_arm(files, arm)
 
 
+def calibration_frames(ckpt: dict[str, Any], data: str | list[str] | None, arm: str) -> np.ndarray:
+    """Raw snapshots ``[T, 2J, F]`` that static quantisation fixes its ranges on: ``data`` or
+    the checkpoint's first training session (never held-out data)."""
+    files = expand_paths(data) if data else expand_paths(ckpt["config"]["data"]["train"])[:1]
+    return to_raw(load_checked(ckpt, files, arm).x, arm)
+
+
 def heldout_windows(rec: Recording, window: int, count: int, arm: str) -> torch.Tensor:
     """Up to ``count`` raw windows ``[K, W, 2J, F]`` (arm ``arm``'s readings) spread over a
     held-out recording."""
@@ -217,9 +224,14 @@ def export_checkpoint(
     data: str | list[str] | None = None,
     parity_windows: int = 256,
     arm: str | None = None,
+    quantise: str | None = None,
+    calibration: str | list[str] | None = None,
 ) -> dict[str, Any]:
     """Write ``out`` (ONNX) for the arm ``data`` comes from (``arm`` where it names none) and
-    verify it against PyTorch on real held-out windows of it."""
+    verify it against PyTorch on real held-out windows of it; with ``quantise`` (``dynamic``,
+    ``static``), its int8 form instead, calibrated on ``calibration`` (default: the
+    checkpoint's first training session) and measured against the float form on those
+    held-out windows."""
     ckpt = load_checkpoint(ckpt_path)
     model = model_from_checkpoint(ckpt)
     if callable(getattr(model, "fit", None)):
@@ -282,6 +294,18 @@ def export_checkpoint(
         **commissioning_metadata(ckpt),
         **incremental,
     )
+    if quantise:
+        from robohealth_mj.deploy.quantise import quantise_model
+
+        float_path = out.with_name(f".{out.name}.float.tmp")
+        attach_metadata(tmp, float_path, metadata)
+        side_data.unlink(missing_ok=True)
+        frames = calibration_frames(ckpt, calibration, target) if quantise == "static" else None
+        try:
+            result = quantise_model(float_path, out, quantise, frames, windows.numpy())
+        finally:
+            float_path.unlink(missing_ok=True)
+        return {**result, "parity_error": error, "windows": len(windows)}
     attach_metadata(tmp, out, metadata)  # writes one self-contained file
     side_data.unlink(missing_ok=True)
     return {

@@ -35,6 +35,7 @@ from robohealth_mj.data.windows import (
 )
 from robohealth_mj.learn.checkpoint import save_checkpoint, training_arms
 from robohealth_mj.learn.data import WindowTensors
+from robohealth_mj.learn.distill import load_teacher, soft_label_loss
 from robohealth_mj.learn.loss import loss_from_config
 from robohealth_mj.learn.metrics import metrics_of
 from robohealth_mj.learn.motion_placement import training_placement
@@ -239,6 +240,14 @@ def fit_gradient(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
     )
 
     loss_fn = loss_from_config(t)
+    teacher = load_teacher(
+        t.get("distill"), int(cfg.window), p.graph.name, p.mean, p.std, split_runs(p), p.device
+    )
+    if teacher is not None and p.pool is not None:
+        raise InputError(
+            "trainer.distill.teacher with trainer.placements: the teacher was not given the "
+            "drawn placements; choose one"
+        )
     generator = torch.Generator().manual_seed(int(cfg.seed))
     placements = torch.Generator().manual_seed(int(cfg.seed) + 1)  # the pool's draws
     best_score, best_epoch, history, stale = -math.inf, -1, [], 0
@@ -263,6 +272,12 @@ def fit_gradient(p: Prepared, out_dir: Path, writer) -> tuple[int, list[dict]]:
                 snapshots = p.tensors.snapshots(train_windows, which)
                 out = model(*p.pool.mix(batch.x, snapshots, placements))
             loss, _ = loss_fn(out, batch)
+            if teacher is not None:  # (1 - w) hard labels + w the teacher's soft ones
+                soft = soft_label_loss(
+                    out, teacher.outputs(batch.x), batch.active, teacher.temperature,
+                    float(t.joint_loss_weight),
+                )  # fmt: skip
+                loss = (1.0 - teacher.weight) * loss + teacher.weight * soft
             optimiser.zero_grad(set_to_none=True)
             loss.backward()
             optimiser.step()

@@ -40,6 +40,7 @@ from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.contact import ContactBank, ContactPolicy, contact_metadata
 from robohealth_mj.runtime.evidence import EvidenceBank, EvidencePolicy
+from robohealth_mj.runtime.hold import DecisionHold
 from robohealth_mj.runtime.incremental import IncrementalEngine, WindowedEngine
 from robohealth_mj.runtime.phases import NO_CLOCK, NoClock
 
@@ -139,9 +140,12 @@ class FleetRuntime:
         observability: str = "all",
         contact: ContactPolicy | None = None,
         strict: bool = False,
+        decide_every: int = 1,
     ) -> None:
         """``strict``: a model named but missing or unusable raises (a command's user named
-        it) instead of leaving the runtime running without one (a library's caller)."""
+        it) instead of leaving the runtime running without one (a library's caller).
+        ``decide_every``: run the model on a stream every this many ticks and hold its outputs
+        in between (:mod:`robohealth_mj.runtime.hold`); 1: every tick."""
         self.observability = check_observability(observability)
         self.contact_policy = contact or ContactPolicy()
         self.contact: ContactBank | None = None  # set by a model that carries thresholds
@@ -167,6 +171,7 @@ class FleetRuntime:
         self._load(model_path, threads, incremental, capacity, providers, strict)
         if self.engine is not None and observability == "motion":  # the model must read motion
             check_observability(observability, load_profile(self.sensing).joint_channels)
+        self.hold = DecisionHold(decide_every, capacity)
         self.alarms = AlarmBank(alarm or AlarmPolicy(), len(self.joints), capacity)
         self.evidence = EvidenceBank(evidence or EvidencePolicy(), len(self.classes), capacity)
         self.last_t = np.full(capacity, -np.inf)
@@ -306,6 +311,7 @@ class FleetRuntime:
         self.last_moved[slot] = _NEVER
         if self.engine is not None:
             self.engine.reset(np.array([slot]))
+        self.hold.reset(np.array([slot]))
         self.alarms.reset(np.array([slot]))
         self.evidence.reset(np.array([slot]))
         if self.contact is not None:
@@ -315,6 +321,7 @@ class FleetRuntime:
     def _grow(self, capacity: int) -> None:
         if self.engine is not None:
             self.engine.ensure(capacity)
+        self.hold.ensure(capacity)
         self.alarms.ensure(capacity)
         self.evidence.ensure(capacity)
         if self.contact is not None:
@@ -426,6 +433,7 @@ class FleetRuntime:
             )
         if gap.any():  # the window restarts, and the evidence with it
             self.engine.reset(gs[gap])
+            self.hold.reset(gs[gap])
             self.evidence.reset(gs[gap])
             self.last_moved[gs[gap]] = _NEVER
             if self.contact is not None:
@@ -494,7 +502,7 @@ class FleetRuntime:
             self.engine.push(s, x[p])
             full = self.engine.full(s)
             ready = full & decide[p]
-            return full, self.engine.infer(s[ready]) if ready.any() else None
+            return full, self.hold.decide(s[ready], self.engine.infer) if ready.any() else None
 
         pool = self._pool if shards > 1 else None
         done = list(pool.map(shard, parts)) if pool is not None else [shard(p) for p in parts]
@@ -523,6 +531,7 @@ class FleetRuntime:
             "window": self.window,
             "mode": self.mode,
             "threads": self.threads,
+            "decide_every": self.hold.every,
             "joint_scores": self.joint_scores,
             "observability": self.observability,
             "contact": None if self.contact is None else self.contact.threshold.tolist(),

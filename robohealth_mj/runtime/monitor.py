@@ -69,6 +69,13 @@ def refuse_other_arm(model_arm: str, data_arm: str | None, source: str) -> None:
         )
 
 
+def decide_every(value: object) -> int:
+    """``decide_every`` as a tick count, or a one-line refusal."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise InputError(f"decide_every: {value!r} is not a whole number of ticks >= 1")
+    return value
+
+
 def monitor_policies(cfg: DictConfig) -> tuple[AlarmPolicy, EvidencePolicy, ContactPolicy]:
     """The ``alarm``, ``evidence`` and ``contact`` blocks as their policies; a bad value is the
     user's to fix, named by its block."""

@@ -126,10 +126,12 @@ class ModelRuntime:
         observability: str = "all",
         contact: ContactPolicy | None = None,
         strict: bool = False,
+        decide_every: int = 1,
     ) -> None:
         self.fleet = FleetRuntime(
             model_path, threads=threads, alarm=alarm, evidence=evidence, incremental=incremental,
             observability=observability, contact=contact, strict=strict,
+            decide_every=decide_every,
         )  # fmt: skip
         self._queue: list[tuple[int, GraphSample]] = []
 

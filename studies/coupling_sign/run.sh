@@ -30,12 +30,7 @@ run() {  # out_dir, then overrides: one training run of one thread
     data.evaluate.heldout="$CORPUS/heldout_seed900" '~data.evaluate.probe' \
     out_dir="$ROOT/$out" "$@" >"$ROOT/logs/${out//\//_}.log" 2>&1 || echo "failed: $out" >&2
 }
-export -f run
-export PY ROOT CORPUS
-parallel_runs() {  # lines of "out_dir override ..." on stdin, JOBS at a time
-  mkdir -p "$ROOT/logs"
-  xargs -P "$JOBS" -L 1 bash -c 'run "$@"' _
-}
+source studies/parallel_runs.sh  # parallel_runs: JOBS of these runs at a time
 joint_line() {  # "name:profile:coupling_seed:coupling_sensors:seed" -> one joint-score run line
   local name s cs cm seed place="" part=placements
   IFS=: read -r name s cs cm seed <<<"$1"

@@ -21,6 +21,7 @@ from robohealth_mj.bags.messages import MessageFactory, stamp_ns, typestore
 from robohealth_mj.bags.reader import BagError, bag_manifest, read_bag_samples
 from robohealth_mj.bags.topics import BagTopics
 from robohealth_mj.bags.writer import BagWriter, write_bag
+from robohealth_mj.common.config import compose_config
 from robohealth_mj.data.arrays import load_recordings
 from robohealth_mj.data.read import read_samples
 from robohealth_mj.dataset import main as dataset_main
@@ -283,8 +284,10 @@ def test_monitor_replays_a_bag_and_writes_its_diagnoses_beside_the_topics(
 
     from_jsonl, from_bag = _diagnoses(diagnosed["jsonl"]), _diagnoses(diagnosed["bag"])
     assert len(from_bag) == len(list(read_samples(bag))) and from_jsonl == from_bag
-    # the levels are the runtime's alarms: ERROR exactly while one is up
-    runtime = ModelRuntime(deployed["structural_onnx"], alarm=deciding_alarm)
+    # the levels are the runtime's alarms: ERROR exactly while one is up (the runtime run as
+    # the monitor runs it, the model every decide_every-th tick)
+    every = compose_config("monitor", []).decide_every
+    runtime = ModelRuntime(deployed["structural_onnx"], alarm=deciding_alarm, decide_every=every)
     expected = []
     for sample in read_samples(deployed["heldout"]):
         d = runtime.process("arm1", sample)

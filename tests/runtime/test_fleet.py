@@ -389,7 +389,8 @@ def test_sharded_steps_decide_as_one_shard_does(deployed):
     assert (r.status == DECIDED).all()
     assert two.describe() == {
         "model_id": one.model_id, "arm": "ur5e", "window": 8, "mode": "incremental", "threads": 1,
-        "joint_scores": "softmax", "observability": "all", "contact": None, "problem": None,
+        "decide_every": 1, "joint_scores": "softmax", "observability": "all", "contact": None,
+        "problem": None,
     }  # fmt: skip
     assert one.model_id.startswith("stgnn_fixed-structural-w8-")
 

@@ -52,3 +52,29 @@ def test_the_stock_model_diagnoses_the_sample_log_by_name(capsys):
     assert lines and all(": no model" not in line for line in lines)
     called = [float(line[2:].split("s")[0]) for line in lines if ": friction @" in line]
     assert called and min(called) >= 20.0
+
+
+def test_the_fleet_default_keeps_the_headlines_detections_on_a_session_it_never_saw(tmp_path):
+    """The cost frontier's deployment default (``decide_every`` of conf/monitor.yaml, the model
+    run on an arm every k-th tick) against the headline as it ran before (every tick), the ready
+    ``full`` model both times, on a simulated session of every fault mode at severity 0.9 on one
+    joint: it detects what the headline detects (a floor of one episode) and decides nearly as
+    well tick by tick."""
+    from robohealth_mj.common.config import compose_config
+
+    every = compose_config("monitor", []).decide_every
+    assert every > 1  # the default buys its streams by deciding every k-th tick
+    session = ('"seed=77","faults.schedule.fault_s=4.0","faults.schedule.healthy_s=3.0",'
+               '"faults.schedule.severities=[0.9]","faults.schedule.joints=[elbow]"')  # fmt: skip
+
+    def run(k: int) -> dict:
+        args = ["model=full", "source=sim", "duration_s=45", f"sim_overrides=[{session}]",
+                "evaluate=true", "quiet=true", "threads=1", f"decide_every={k}",
+                f"out={tmp_path / f'k{k}.json'}"]  # fmt: skip
+        return monitor(args)
+
+    headline, default = run(1), run(every)
+    assert headline["episodes"] >= 5 and headline["alarms"]["detected"] >= 3  # the floor
+    assert default["alarms"]["detected"] >= headline["alarms"]["detected"] - 1
+    assert default["online_accuracy"] >= headline["online_accuracy"] - 0.05
+    assert default["false_alarms"] <= headline["false_alarms"]

@@ -327,6 +327,7 @@ def test_monitor_replays_and_evaluates_with_its_alarm_settings(
             "source=replay",
             f"file={deployed['heldout']}",
             "evaluate=true",
+            "decide_every=1",  # the alarm sweep below replays a decision every tick
             *deciding_alarm_args,
             f"out={out}",
         ]
