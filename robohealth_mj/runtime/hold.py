@@ -12,6 +12,7 @@ newest window).
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable
 
 import numpy as np
@@ -27,6 +28,7 @@ class DecisionHold:
         self.age = np.zeros(capacity, np.int64)
         self.valid = np.zeros(capacity, bool)  # a held output of the current window run
         self.outputs: list[np.ndarray] | None = None
+        self._first = threading.Lock()
 
     def ensure(self, capacity: int) -> None:
         n = capacity - len(self.age)
@@ -54,9 +56,10 @@ class DecisionHold:
         run = slots[due]
         if len(run):
             got = infer(run)
-            if self.outputs is None:
-                cap = len(self.age)
-                self.outputs = [np.zeros((cap, *o.shape[1:]), o.dtype) for o in got]
+            with self._first:  # shard threads decide disjoint slots; the arrays are made once
+                if self.outputs is None:
+                    cap = len(self.age)
+                    self.outputs = [np.zeros((cap, *o.shape[1:]), o.dtype) for o in got]
             for held, new in zip(self.outputs, got, strict=True):
                 held[run] = new
             first = ~self.valid[run]

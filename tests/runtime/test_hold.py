@@ -22,7 +22,7 @@ def _replay(fleet: FleetRuntime, x: np.ndarray, streams: int, ticks: int, skip: 
     infer = fleet.engine.infer
     fleet.engine.infer = lambda slots: (calls.append(len(slots)), infer(slots))[1]
     slots = fleet.register([f"s{k}" for k in range(streams)])
-    offsets = 97 * np.arange(streams)
+    offsets = 97 * np.arange(streams) % (len(x) - ticks)
     probs = np.full((ticks, streams, len(fleet.classes)), np.nan)
     per_tick = []
     for t in range(ticks):
@@ -80,3 +80,16 @@ def test_the_monitor_refuses_a_bad_decide_every_in_one_line():
     lines = [line for line in proc.stderr.splitlines() if line.strip()]
     assert proc.returncode == 2 and len(lines) == 1, proc.stderr
     assert "decide_every: 0 is not a whole number of ticks >= 1" in lines[0]
+
+
+def test_two_shard_threads_hold_as_one_thread_does(deployed):
+    """Shard threads decide disjoint slots at once, the first tick included (the held arrays
+    are made once, whichever thread gets there first)."""
+    rec = load_recordings([deployed["heldout"]])
+    one = FleetRuntime(deployed["structural_onnx"], decide_every=3)
+    two = FleetRuntime(deployed["structural_onnx"], decide_every=3, shards=2, capacity=140)
+    a, _ = _replay(one, rec.x, 140, 20, {})
+    b, _ = _replay(two, rec.x, 140, 20, {})
+    assert (~np.isnan(a)).sum() > 140 * 10
+    np.testing.assert_allclose(a, b, atol=1e-6)
+    two.close()
