@@ -2,10 +2,10 @@
 # Issue 66, part 1: what a monitored arm costs, as a frontier of diagnostic quality against
 # MFLOP per stream-tick and streams sustained. One part per argument, into outputs/cost_frontier
 # (a finished training run is skipped, so a part resumes after interruption):
-#   bash studies/cost_frontier/run.sh train distill extra export quantise score online bench table
+#   bash studies/cost_frontier/run.sh train distill extra gbdt export quantise score online bench table
 # train: the headline (anomaly_residual, W = 32, hidden 64) and its narrower forms, seeds 42-44
 #   (FORMS, SEEDS to choose);
-# extra: the shallower and shorter-window forms, seed 42;
+# extra: the shallower and shorter-window forms, seed 42; gbdt: the trees beside them, seed 42;
 # distill: STUDENTS (hidden 16; and with a snapshot MLP of 8) trained on the headline's soft
 #   labels (the same seed's teacher: the same split, so no teacher saw a student's validation
 #   windows);
@@ -54,6 +54,8 @@ for part in "$@"; do
       done; done | parallel_runs ;;
     extra)  # one seed each: the shallower and shorter-window points of the frontier
       FORMS="h64_l1 h16_w16" SEEDS=42 bash "$0" train ;;
+    gbdt)  # the reference beside the networks (trees: no fleet form), seed 42
+      echo "gbdt/seed42 variant=gbdt seed=42" | parallel_runs ;;
     distill)
       for form in $STUDENTS; do for seed in $SEEDS; do
         teacher=$ROOT/h64/seed$seed/best.ckpt
@@ -63,6 +65,7 @@ for part in "$@"; do
     export)
       for ckpt in "$ROOT"/*/seed*/best.ckpt; do
         d=$(dirname "$ckpt")
+        case $d in */gbdt/*) continue ;; esac  # trees: no ONNX form
         [ -f "$d/eval_heldout.json" ] || continue  # still training
         [ -f "$d/model.onnx" ] || $PY -m robohealth_mj.export ckpt="$ckpt" out="$d/model.onnx" \
           2>&1 | grep -v torchvision

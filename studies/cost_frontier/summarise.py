@@ -97,6 +97,28 @@ def online_rows(results: Path, bench: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def gbdt_row(root: Path, ref: dict[str, list[float]]) -> str | None:
+    """``gbdt`` beside the networks (its checkpoint's own evaluation: trees have no ONNX form,
+    so no fleet cost), when the runner's gbdt part has run."""
+    run = root / "gbdt" / "seed42"
+    if not (run / "eval_probe.json").is_file():
+        return None
+    summary = json.loads((run / "train_summary.json").read_text())
+    val = summary["history"][summary["best_epoch"] - 1]
+    held, probe = (json.loads((run / f"eval_{n}.json").read_text())["metrics"]
+                   for n in ("heldout", "probe"))  # fmt: skip
+    delta = " / ".join(
+        f"{100 * (held[k] - np.mean(ref[f'heldout_{m}'])):+.1f}"
+        for k, m in (("accuracy", "acc"), ("localisation_accuracy", "loc"))
+    )
+    return (
+        f"| gbdt | gradient-boosted trees (the reference; no ONNX form) | trees | 1 | – | – | "
+        f"{val['val_accuracy']:.3f} / {val['val_localisation']:.3f} | {held['accuracy']:.3f} / "
+        f"{held['localisation_accuracy']:.3f} | {delta} | {probe['accuracy']:.3f} / "
+        f"{probe['localisation_accuracy']:.3f} | {summary['train_seconds']:.0f} |"
+    )
+
+
 def quality(root: Path) -> dict[tuple[str, str], dict[str, list[float]]]:
     """``(form, file kind) -> {set_metric: [per seed]}`` from ``scores.json``, plus train s."""
     scores = json.loads((root / "scores.json").read_text())
@@ -123,7 +145,7 @@ def cell(values: list[float] | None, digits: int = 3) -> str:
     return f"{np.mean(values):.{digits}f} ± {np.std(values):.{digits}f}"
 
 
-def table(q: dict, bench: dict) -> str:
+def table(q: dict, bench: dict, root: Path) -> str:
     ref = q[(HEADLINE, "float")]
     ref_bench = bench.get((HEADLINE, "float", 1), {})
     lines = [
@@ -160,7 +182,8 @@ def table(q: dict, bench: dict) -> str:
                 f"{cell(seeds.get('probe_acc'))} / {cell(seeds.get('probe_loc'))} | "
                 f"{cell(seeds.get('train_s'), 0)} |"
             )
-    return "\n".join(lines) + "\n"
+    reference = gbdt_row(root, ref)
+    return "\n".join(lines + ([reference] if reference else [])) + "\n"
 
 
 def plot(q: dict, bench: dict, out: Path) -> None:
@@ -225,7 +248,7 @@ def main() -> None:
     bench = bench_rows(args.results / "bench_compare.txt")
     atomic_write_text(
         args.results / "frontier.md",
-        "## Quality and cost of each form\n\n" + table(q, bench)
+        "## Quality and cost of each form\n\n" + table(q, bench, args.root)
         + "\n## The model every k ticks: on-line figures and cost (seed 42)\n\n"
         + online_rows(args.results, bench),
     )  # fmt: skip
