@@ -46,17 +46,20 @@ class Decisions:
     arm: str = DEFAULT_ARM  # whose ratings the torques are read against
 
 
-def replay_decisions(model: str | Path, recording: str | Path) -> Decisions:
-    """Run the fleet runtime (one stream) over a recording's samples in order."""
-    return replay_many(model, [recording])[0]
+def replay_decisions(model: str | Path, recording: str | Path, decide_every: int = 1) -> Decisions:
+    """Run the fleet runtime (one stream) over a recording's samples in order; the model every
+    ``decide_every``-th tick, as the monitor runs it with that setting."""
+    return replay_many(model, [recording], decide_every)[0]
 
 
-def replay_many(model: str | Path, recordings: Sequence[str | Path]) -> list[Decisions]:
+def replay_many(
+    model: str | Path, recordings: Sequence[str | Path], decide_every: int = 1
+) -> list[Decisions]:
     """:func:`replay_decisions` for several recordings at once: one stream each in one fleet, so
     the network runs once a tick for all of them. Streams are independent: each recording gets
     the decisions it gets alone, its probabilities to float32 rounding (a batch runs other
     kernels than one stream). A shorter recording's stream stops at its end."""
-    fleet = FleetRuntime(model)
+    fleet = FleetRuntime(model, decide_every=decide_every)
     if fleet.engine is None:
         raise InputError(fleet.problem)
     recs = [load_recordings([Path(r)]) for r in recordings]

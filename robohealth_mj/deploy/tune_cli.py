@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import argparse
 
+from robohealth_mj.common.config import compose_config
 from robohealth_mj.common.errors import one_line_errors
+from robohealth_mj.runtime.monitor import decide_every
 
 with one_line_errors("tune_alarms"):  # a missing extra is one line, not a traceback
     from robohealth_mj.deploy.alarm_sweep import choose, meets_targets, replay_decisions, sweep
@@ -37,10 +39,20 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--model", required=True, help="an exported model.onnx")
     parser.add_argument("--data", required=True, help="a selection session's graphs.jsonl")
     parser.add_argument("--healthy", help="a healthy-only selection session, for false alarms/h")
+    parser.add_argument(
+        "--decide-every", type=int, default=None,
+        help="the model every this many ticks, as the monitor runs it (default: the monitor's "
+        "decide_every)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     with one_line_errors("tune_alarms"):
-        decisions = replay_decisions(args.model, args.data)
-        healthy = replay_decisions(args.model, args.healthy) if args.healthy else None
+        every = decide_every(
+            compose_config("monitor", []).decide_every
+            if args.decide_every is None
+            else args.decide_every
+        )
+        decisions = replay_decisions(args.model, args.data, every)
+        healthy = replay_decisions(args.model, args.healthy, every) if args.healthy else None
     rows = sweep(decisions, healthy=healthy)
     print(
         f"selection: {args.data} (faults)"

@@ -327,7 +327,7 @@ def test_monitor_replays_and_evaluates_with_its_alarm_settings(
             "source=replay",
             f"file={deployed['heldout']}",
             "evaluate=true",
-            "decide_every=1",  # the alarm sweep below replays a decision every tick
+            "decide_every=3",  # the model every third tick; the sweep below replays the same
             *deciding_alarm_args,
             f"out={out}",
         ]
@@ -343,7 +343,7 @@ def test_monitor_replays_and_evaluates_with_its_alarm_settings(
     raised = [line for line in printed.splitlines() if "ALARM RAISED" in line]
     assert len(raised) >= 8 and sum("CLEARED" in line for line in printed.splitlines()) >= 5
     # the alarm sweep replays the same policy over the same decisions to the same figures
-    swept = evaluate_policy(replay_decisions(deployed["structural_onnx"], deployed["heldout"]),
+    swept = evaluate_policy(replay_decisions(deployed["structural_onnx"], deployed["heldout"], 3),
                             deciding_alarm)  # fmt: skip
     for key in ("alarms", "false_alarms", "settled_healthy_ticks", "online_accuracy"):
         assert swept[key] == result[key], key
