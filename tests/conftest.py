@@ -153,6 +153,12 @@ def learnable_corpus(tmp_path_factory) -> Path:
     return Path(cached(tmp_path_factory, "learnable", recorder)["root"])
 
 
+@pytest.fixture(scope="session")
+def tiny_train_config() -> Callable:
+    """``(corpus, *overrides)`` -> the training config of the tests' small models."""
+    return _tiny_train_config
+
+
 def _tiny_train_config(corpus: Path, *overrides: str):
     """The training config of the tests' small models: W = 8 on ``corpus``'s sessions."""
     return compose_config(

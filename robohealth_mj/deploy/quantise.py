@@ -30,6 +30,7 @@ import onnx
 from robohealth_mj import schema
 from robohealth_mj.common.atomic import atomic_write_bytes
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.common.numeric import softmax
 
 MODES = ("dynamic", "static")
 QUANTISED_OPS = ["MatMul", "Gemm"]
@@ -180,15 +181,10 @@ def agreement(float_model: bytes, int8_model: bytes, windows: np.ndarray) -> dic
     cls_ref, cls_got = ref[0].argmax(-1), got[0].argmax(-1)
     faulted = (cls_ref > 0) | (cls_got > 0)
     same_joint = ref[1].argmax(-1) == got[1].argmax(-1)
-
-    def probs(logits: np.ndarray) -> np.ndarray:
-        e = np.exp(logits - logits.max(-1, keepdims=True))
-        return e / e.sum(-1, keepdims=True)
-
     return {
         "class_agreement": float((cls_ref == cls_got).mean()),
         "joint_agreement": float(same_joint[faulted].mean()) if faulted.any() else 1.0,
-        "max_probability_difference": float(np.abs(probs(ref[0]) - probs(got[0])).max()),
+        "max_probability_difference": float(np.abs(softmax(ref[0]) - softmax(got[0])).max()),
     }
 
 

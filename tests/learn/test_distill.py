@@ -3,33 +3,17 @@ student's validation runs, or reads other windows, is refused in one line."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 import torch
 
-from robohealth_mj.common.config import compose_config
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.learn.distill import soft_label_loss
 from robohealth_mj.learn.evaluation import score_checkpoint
 from robohealth_mj.learn.run import train_and_evaluate as run
 
-
-def _cfg(corpus: Path, *extra: str):
-    return compose_config(
-        "train",
-        [
-            f"data.train=[{corpus}/train_*]",
-            f"data.evaluate.heldout={corpus}/heldout",
-            "data.evaluate.probe=null",
-            "trainer.progress=false",
-            "variant=anomaly_residual",
-            "window=8",
-            "threads=1",
-            *extra,
-        ],
-    )
+STUDENT = ("variant=anomaly_residual", "threads=1")  # one thread: the same bytes per seed
+TINY = ("model.hidden=8", "trainer.epochs=1")
 
 
 def test_soft_label_loss_is_zero_on_the_teachers_own_logits_and_grows_away_from_them():
@@ -59,15 +43,18 @@ def _kl_to(teacher: np.ndarray, student: np.ndarray) -> float:
 
 @pytest.mark.slow
 def test_a_distilled_student_ends_nearer_its_teacher_than_one_taught_by_labels(
-    learnable_corpus, tmp_path
+    learnable_corpus, tiny_train_config, tmp_path
 ):
-    run(_cfg(learnable_corpus, "model.hidden=32", "trainer.epochs=6"), tmp_path / "teacher")
+    def cfg(*extra: str):
+        return tiny_train_config(learnable_corpus, *STUDENT, *extra)
+
+    run(cfg("model.hidden=32", "trainer.epochs=6"), tmp_path / "teacher")
     teacher = tmp_path / "teacher" / "best.ckpt"
     student = ["model.hidden=8", "trainer.epochs=3", "trainer.patience=null"]
-    run(_cfg(learnable_corpus, *student), tmp_path / "labels")
+    run(cfg(*student), tmp_path / "labels")
     run(
-        _cfg(learnable_corpus, *student, f"trainer.distill.teacher={teacher}",
-             "trainer.distill.weight=1.0", "trainer.distill.temperature=1.0"),
+        cfg(*student, f"trainer.distill.teacher={teacher}", "trainer.distill.weight=1.0",
+            "trainer.distill.temperature=1.0"),
         tmp_path / "distilled",
     )  # fmt: skip
     heldout = str(learnable_corpus / "heldout")
@@ -81,16 +68,17 @@ def test_a_distilled_student_ends_nearer_its_teacher_than_one_taught_by_labels(
 
 
 @pytest.mark.slow
-def test_a_teacher_of_another_split_or_window_is_refused_in_one_line(tiny_corpus, tmp_path):
-    run(_cfg(tiny_corpus, "model.hidden=8", "trainer.epochs=1", "seed=43"), tmp_path / "t43")
-    teacher = tmp_path / "t43" / "best.ckpt"
+def test_a_teacher_of_another_split_or_window_is_refused_in_one_line(
+    tiny_corpus, tiny_train_config, tmp_path
+):
+    def cfg(*extra: str):
+        return tiny_train_config(tiny_corpus, *STUDENT, *TINY, *extra)
+
+    run(cfg("seed=43"), tmp_path / "t43")
+    teacher = f"trainer.distill.teacher={tmp_path / 't43' / 'best.ckpt'}"
     with pytest.raises(InputError, match=r"distill\.teacher.*(normalisation|validates or tests)"):
-        run(_cfg(tiny_corpus, "model.hidden=8", "trainer.epochs=1", "seed=42",
-                 f"trainer.distill.teacher={teacher}"), tmp_path / "s42")  # fmt: skip
+        run(cfg("seed=42", teacher), tmp_path / "s42")
     with pytest.raises(InputError, match="reads windows of 8, the student 16"):
-        run(_cfg(tiny_corpus, "model.hidden=8", "trainer.epochs=1", "seed=43", "window=16",
-                 f"trainer.distill.teacher={teacher}"), tmp_path / "w16")  # fmt: skip
+        run(cfg("seed=43", "window=16", teacher), tmp_path / "w16")
     with pytest.raises(InputError, match=r"trainer.distill.weight: 1.5 is not in \(0, 1\]"):
-        run(_cfg(tiny_corpus, "model.hidden=8", "trainer.epochs=1", "seed=43",
-                 f"trainer.distill.teacher={teacher}", "trainer.distill.weight=1.5"),
-            tmp_path / "w")  # fmt: skip
+        run(cfg("seed=43", teacher, "trainer.distill.weight=1.5"), tmp_path / "w")
