@@ -70,7 +70,7 @@ def bench_profile(args: argparse.Namespace, x: np.ndarray) -> list[dict]:
     """Where the fleet step's time goes at each ``--profile`` stream count (unpaced), and the
     ONNX calls' FLOP rate against numpy's matmul rate measured in the same run."""
     cores = os.cpu_count() or 1
-    flops = model_flops(args.model)
+    flops = model_flops(args.model) / args.decide_every
     peak = sgemm_rate()
     print(
         f"\nprofile: {flops / 1e6:.3f} MFLOP per stream and tick in the ONNX calls; numpy sgemm "
@@ -81,7 +81,8 @@ def bench_profile(args: argparse.Namespace, x: np.ndarray) -> list[dict]:
     for streams in args.profile:
         clock = PhaseClock()
         r = trial(args.model, x, streams, args.profile_ticks, shards=args.shards, clock=clock,
-                  chunk=args.chunk, providers=args.providers)  # fmt: skip
+                  chunk=args.chunk, providers=args.providers,
+                  decide_every=args.decide_every)  # fmt: skip
         per_tick = {k: v / args.profile_ticks * 1e3 for k, v in clock.seconds.items()}
         busy = sum(per_tick.values())
         onnx_s = sum(per_tick.get(k, 0.0) for k in ONNX_PHASES) / 1e3
