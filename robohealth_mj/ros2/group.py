@@ -15,6 +15,15 @@ its arms move at once; one that is killed moves them once it has been silent ``t
 What the taker starts from: a fresh window (decisions resume once it has filled) and fresh alarm
 state (an alarm up on the dead monitor is raised again after its persistence), because neither
 travels between processes.
+
+A heartbeat counts from when it was sent, not when it was read: a monitor that stalls past the
+timeout reads the beats queued meanwhile all at once, and a member that died during the stall
+must not look alive for another timeout. The sender's clock need not agree with ours: each beat's
+age (our wall clock less its source timestamp) is taken against the smallest age that member's
+beats showed over the last ``SKEW_WINDOW_S`` (its clock offset plus the bus's delay), so only
+the lateness beyond that counts. The window is long so that a stall shorter than it is judged
+right; the price is that a member whose clock steps forward by more than the timeout looks gone
+to the others for up to that long, and its arms are watched twice meanwhile (none is lost).
 """
 
 from __future__ import annotations
@@ -31,6 +40,7 @@ from robohealth_mj.common.errors import InputError
 
 GROUP_TOPIC = "/robohealth/monitor_group"
 ACTIVE, LEAVING = "active", "leaving"
+SKEW_WINDOW_S = 30.0  # a member's clock offset is the least beat age seen within this long
 
 
 def rank(member: str, arm: str) -> int:
@@ -94,6 +104,7 @@ class MonitorGroup:
         self._reader = bus.reader(GROUP_TOPIC, self._status)
         self._heard: dict[str, float] = {}  # member -> when last heard (monotonic)
         self._first: dict[str, float] = {}  # member -> when first heard this time round
+        self._offset: dict[str, tuple[float, float]] = {}  # member -> (least beat age, since)
         self._next_beat = 0.0
         self._watching: list[str] = []
         self._members: tuple[list[str], list[str]] | None = None  # (live, settled) last shared
@@ -112,7 +123,21 @@ class MonitorGroup:
                 self._first.pop(msg.name, None)
                 continue
             self._first.setdefault(msg.name, now)
-            self._heard[msg.name] = now
+            sent = now - self._lateness(msg.name, msg, now)
+            self._heard[msg.name] = max(self._heard.get(msg.name, sent), sent)
+
+    def _lateness(self, member: str, msg: Any, now: float) -> float:
+        """How much later than its member's usual this beat was read (s, >= 0); 0 when the
+        sample carries no source timestamp."""
+        info = getattr(msg, "sample_info", None)
+        if info is None or not getattr(info, "source_timestamp", 0):
+            return 0.0
+        age = (time.time_ns() - info.source_timestamp) / 1e9
+        least, since = self._offset.get(member, (age, now))
+        if age <= least or now - since > SKEW_WINDOW_S:  # a new least, or the old one expired
+            least, since = age, now
+        self._offset[member] = (least, since)
+        return max(0.0, age - least)
 
     def members(self, now: float | None = None) -> list[str]:
         """The live members, this one included, sorted."""

@@ -207,3 +207,51 @@ def test_a_grouped_monitor_s_grant_adds_the_group_topic_both_ways():
     assert GROUP_TOPIC not in alone.publish + alone.subscribe
     assert GROUP_TOPIC in grouped.publish and GROUP_TOPIC in grouped.subscribe
     assert set(grouped.publish) - set(alone.publish) == {GROUP_TOPIC}
+
+
+class _Queued:
+    """A heartbeat reader whose beats wait until taken, as on the bus: (name, sent ns) pairs."""
+
+    def __init__(self) -> None:
+        self.beats: list[tuple[str, int]] = []
+
+    def take(self, N: int) -> list:  # N: as the binding names it
+        from types import SimpleNamespace
+
+        out, self.beats = self.beats[:N], self.beats[N:]
+        return [SimpleNamespace(name=n, message="active",
+                                sample_info=SimpleNamespace(source_timestamp=t))
+                for n, t in out]  # fmt: skip
+
+
+class _QueuedBus:
+    def __init__(self) -> None:
+        self.queue = _Queued()
+
+    def writer(self, *_):
+        from types import SimpleNamespace
+
+        return SimpleNamespace(write=lambda msg: None)
+
+    def reader(self, *_):
+        return self.queue
+
+
+@pytest.mark.parametrize("offset_s", [0.0, 5.0, -5.0])
+def test_beats_read_late_count_from_when_they_were_sent_whatever_the_sender_s_clock(offset_s):
+    """A monitor that stalls past the timeout reads the queued beats of a member that died
+    meanwhile: that member is gone at once, not alive for another timeout; one still beating is
+    kept. The members' clocks may be seconds off ours."""
+    bus = _QueuedBus()
+    group = MonitorGroup(bus, GroupConfig("a", heartbeat_s=0.05, timeout_s=0.4), ARMS)
+    skew = int(offset_s * 1e9)
+    now = time.monotonic()
+    for name in ("b", "c"):  # heard promptly: the least age of each member's beats
+        bus.queue.beats.append((name, time.time_ns() + skew))
+    group.update(now)
+    assert group.members(now) == ["a", "b", "c"]
+    # b beat once more and died; a stalled 1 s (2.5 timeouts); c beat just before a woke
+    bus.queue.beats += [("b", time.time_ns() + skew - int(1.0e9)), ("c", time.time_ns() + skew)]
+    later = now + 1.0
+    group.update(later)
+    assert group.members(later) == ["a", "c"]
