@@ -15,6 +15,9 @@
 # C0 full and placement 1 retrofit (seed 42).
 # joint_more: the same form on C0 at seeds 43 and 44 (full) and 42-44 (retrofit), on placements 3
 # and 5 (full) and on placement 2 (retrofit), seed 42 where not said.
+# grid: that recipe and gbdt on all ten placements (placement_fits.py's), GRID_PROFILES (default
+# both) at GRID_SEEDS (default 42); archive: the finished runs' records into results/runs
+# (committed); grid_table: results/grid.md from that archive.
 # JOBS parallel runs of one thread each (default 2, for 2 cores).
 set -euo pipefail
 PY=${PY:-.venv/bin/python}
@@ -24,8 +27,9 @@ CORPUS=${CORPUS:-outputs/corpus/standard}
 HERE=studies/coupling_sign
 
 run() {  # out_dir, then overrides: one training run of one thread
-  local out=$1; shift
-  $PY -m robohealth_mj.train graph=harness window=32 model.anomaly_scores=energy \
+  local out=$1 scores=(model.anomaly_scores=energy); shift
+  [[ " $* " == *" variant=gbdt "* ]] && scores=()  # the trees have no anomaly scores
+  $PY -m robohealth_mj.train graph=harness window=32 "${scores[@]}" \
     threads=1 trainer.progress=false "data.train=[$CORPUS/train_*]" \
     data.evaluate.heldout="$CORPUS/heldout_seed900" '~data.evaluate.probe' \
     out_dir="$ROOT/$out" "$@" >"$ROOT/logs/${out//\//_}.log" 2>&1 || echo "failed: $out" >&2
@@ -76,6 +80,22 @@ for part in "$@"; do
                seed3_m6:full:3:6:42 seed5_m4:full:5:4:42 seed2_m4:retrofit:2:4:42; do
         joint_line "$p"
       done | parallel_runs ;;
+    grid)
+      fits="import sys; sys.path.insert(0, '$HERE'); import placement_fits as f"
+      places=$($PY -c "$fits; print(f.PLACEMENTS)")  # the placements the fits cover
+      for seed in ${GRID_SEEDS:-42}; do for s in ${GRID_PROFILES:-full retrofit}; do
+      for p in ${places//,/ }; do
+        joint_line "seed${p%:*}_m${p#*:}:$s:${p%:*}:${p#*:}:$seed"
+        echo "placements/$s/seed${p%:*}_m${p#*:}/gbdt/seed$seed variant=gbdt sensing=$s" \
+          "seed=$seed graph.coupling_seed=${p%:*} graph.coupling_sensors=${p#*:}"
+      done; done; done | parallel_runs ;;
+    archive)  # each finished run's summary and held-out figures, nothing heavier
+      for f in "$ROOT"/placements/*/*/*/seed*/{train_summary,eval_heldout}.json; do
+        [ -f "$f" ] || continue
+        dest=$HERE/results/runs/${f#"$ROOT"/placements/}
+        mkdir -p "$(dirname "$dest")" && cp "$f" "$dest"
+      done ;;
+    grid_table) $PY $HERE/summarise.py --grid $HERE/results/grid.md ;;
     summary) $PY $HERE/summarise.py --root "$ROOT" --out $HERE/results/results.md ;;
     *) echo "unknown part: $part" >&2; exit 2 ;;
   esac
