@@ -222,12 +222,6 @@ def main() -> None:
                 (f"{place} motion + joint scores", ours(f"placements/{pr}/{place}/*_joint/seed42")),
             ]  # fmt: skip
         lines += [f"### {pr}", "", *table(rows), ""]
-    lines += [
-        "## Ten placements, both profiles (the grid; archived runs)",
-        "",
-        *grid_section(ARCHIVE),
-        "",
-    ]
     lines += ["## Reconstruction weight (C0, full, seed 42)", ""]
     weights = [
         ("0.1 losses", thesis("full/C0/anomaly_residual/w32/seed42")),
