@@ -1,4 +1,4 @@
-"""Wear read straight from the channel each of two mechanical modes acts on, per joint.
+"""Wear read straight from the recorded channels each mechanical mode acts on, per joint.
 
 The window model's severity head levels off for friction and backlash (the index stops rising
 at half the wear on long lives, so the trend warns weeks early), yet the physics carries both
@@ -11,8 +11,12 @@ held-out and fresh lives, ``studies/wear/severity_channels.py``):
 
 A reading divided by its (mode, joint)'s *scale*, the reading per unit severity fitted as a line
 through the origin on labelled fault episodes (the standard corpus holds every pair at 0.3, 0.6
-and 0.9), is in severity units. :class:`ChannelSums` accumulates a session tick by tick, as the
-monitor sees it. NumPy only.
+and 0.9), is in severity units. Five more channels, read the same way, carry the other two
+modes and tell the four apart (:mod:`robohealth_mj.prognostics.signature`): the residual's
+spread (a jam's torque impulses), the lag signed against the motion, the lag per unit drive
+torque (a softer drive), and the joint's sensor package's vibration overall and in its highest
+band (the impacts of a gap or a catching gear). :class:`ChannelSums` accumulates a session tick
+by tick, as the monitor sees it. NumPy only.
 """
 
 from __future__ import annotations
@@ -25,37 +29,74 @@ import numpy as np
 from robohealth_mj.data.observability import MOVING_RAD_S
 from robohealth_mj.schema import FAULT_CLASSES, FEATURE_NAMES
 
-MODES = ("friction", "backlash")
+MODES = ("friction", "backlash")  # the modes with a scale: the first two channels
+CHANNELS = (
+    "friction",  # mean effort_residual x sign(vel) while turning
+    "lag",  # RMS pos_error while turning
+    "residual_rms",  # RMS effort_residual while turning
+    "lag_against_motion",  # mean pos_error x sign(vel) while turning
+    "gap",  # pos_error = gap x sign(effort) + compliance x effort, fitted while turning:
+    "compliance",  # a dead zone (backlash) against a softer spring (stiffness loss)
+    "vibration",  # mean of the joint's sensor's vib
+    "vibration_high",  # mean of its vib_200_450 band
+    "speed",  # mean |vel| while turning: not a wear channel, the duty the others depend on
+)
+_F = {name: i for i, name in enumerate(FEATURE_NAMES)}
 
 
 class ChannelSums:
-    """A session's running sums per joint: ticks turned, friction's and backlash's terms."""
+    """A session's running sums per joint, one per channel term (joints' nodes first; a
+    joint's sensor package, where the sample has one, at node ``J + joint``)."""
 
     def __init__(self, n_joints: int) -> None:
-        self.turned = np.zeros(n_joints)
-        self.friction = np.zeros(n_joints)
-        self.lag = np.zeros(n_joints)
+        self.n = n_joints
+        self.turned = np.zeros(n_joints)  # ticks the joint turned in
+        self.ticks = np.zeros(n_joints)  # ticks its sensor package was read
+        self.moving_sums = np.zeros((9, n_joints))  # over the turning ticks, see readings()
+        self.sensor_sums = np.zeros((2, n_joints))  # vib, vib_200_450
 
     def add(self, x: np.ndarray) -> None:
-        """Snapshots ``x [T, N, F]`` or one ``[N, F]`` (the joints' nodes first)."""
+        """Snapshots ``x [T, N, F]`` or one ``[N, F]``."""
         x = np.asarray(x, float)
         x = x[None] if x.ndim == 2 else x
-        joints = x[:, : len(self.turned), :]
-        vel = joints[..., FEATURE_NAMES.index("vel")]
+        joints = x[:, : self.n, :]
+        vel = joints[..., _F["vel"]]
         moving = np.abs(vel) > MOVING_RAD_S
-        residual = joints[..., FEATURE_NAMES.index("effort_residual")] * np.sign(vel)
+        sign = np.sign(vel)
+        residual = joints[..., _F["effort_residual"]]
+        pos_error = joints[..., _F["pos_error"]]
+        effort = joints[..., _F["effort"]]
+        terms = (residual * sign, pos_error**2, residual**2, pos_error * sign,
+                 pos_error * np.sign(effort), pos_error * effort, np.abs(effort), effort**2,
+                 np.abs(vel))  # fmt: skip
         self.turned += moving.sum(axis=0)
-        self.friction += (residual * moving).sum(axis=0)
-        self.lag += (joints[..., FEATURE_NAMES.index("pos_error")] ** 2 * moving).sum(axis=0)
+        for k, term in enumerate(terms):
+            self.moving_sums[k] += (term * moving).sum(axis=0)
+        if x.shape[1] >= 2 * self.n:
+            sensors = x[:, self.n : 2 * self.n, :]
+            self.ticks += len(x)
+            self.sensor_sums[0] += sensors[..., _F["vib"]].sum(axis=0)
+            self.sensor_sums[1] += sensors[..., _F["vib_200_450"]].sum(axis=0)
 
     def readings(self) -> np.ndarray:
-        """``[2, J]`` friction's and backlash's readings (NaN for a joint that never turned)."""
+        """``[C, J]`` each channel's reading (:data:`CHANNELS`; NaN for a joint that never turned
+        and for the vibration of samples without sensor packages)."""
+        m, t = self.moving_sums, np.where(self.turned > 0, self.turned, np.nan)
+        ticks = np.where(self.ticks > 0, self.ticks, np.nan)
         with np.errstate(invalid="ignore", divide="ignore"):
-            return np.stack([self.friction / self.turned, np.sqrt(self.lag / self.turned)])
+            # least squares of pos_error on [sign(effort), effort]: [[n, |e|], [|e|, e^2]] b = rhs
+            det = self.turned * m[7] - m[6] ** 2
+            gap = (m[7] * m[4] - m[6] * m[5]) / det
+            compliance = (self.turned * m[5] - m[6] * m[4]) / det
+            fitted = np.abs(det) > 1e-12 * np.maximum(self.turned * m[7], 1e-300)
+            moving = [m[0] / t, np.sqrt(m[1] / t), np.sqrt(m[2] / t), m[3] / t]
+            fit = [np.where(fitted, gap, np.nan), np.where(fitted, compliance, np.nan)]
+            sensed = [self.sensor_sums[0] / ticks, self.sensor_sums[1] / ticks]
+            return np.stack([*moving, *fit, *sensed, m[8] / t])
 
 
 def channel_readings(x: np.ndarray, n_joints: int) -> np.ndarray:
-    """``[2, J]`` each mode's reading on each joint from snapshots ``x [T, N, F]``."""
+    """``[C, J]`` each channel's reading on each joint from snapshots ``x [T, N, F]``."""
     sums = ChannelSums(n_joints)
     sums.add(x)
     return sums.readings()

@@ -121,14 +121,15 @@ class Calibration:
     @classmethod
     def fit(cls, raw: np.ndarray, truth: np.ndarray, knots: int = 12) -> Calibration:
         """Isotonic regression of ``truth`` on ``raw`` (pool-adjacent-violators), thinned to at
-        most ``knots`` points at the raw index's quantiles."""
+        most ``knots`` points at the quantiles of the raw index's distinct values (a raw form
+        that reads most joint-days as exactly 0 would otherwise put every knot there)."""
         order = np.argsort(raw, kind="stable")
         xs, ys = np.asarray(raw, float)[order], np.asarray(truth, float)[order]
         fitted = isotonic(ys)
-        picks = np.unique(np.linspace(0, len(xs) - 1, knots).round().astype(int))
-        kx, ky = xs[picks], fitted[picks]
-        keep = np.concatenate([[True], np.diff(kx) > 0])
-        return cls(kx[keep].round(6).tolist(), np.clip(ky[keep], 0.0, 1.0).round(6).tolist())
+        ux, first = np.unique(xs, return_index=True)
+        uy = np.add.reduceat(fitted, first) / np.diff(np.append(first, len(xs)))
+        picks = np.unique(np.linspace(0, len(ux) - 1, knots).round().astype(int))
+        return cls(ux[picks].round(6).tolist(), np.clip(uy[picks], 0.0, 1.0).round(6).tolist())
 
     def __call__(self, raw: np.ndarray | float) -> np.ndarray:
         return np.interp(raw, self.x, self.y)

@@ -9,8 +9,13 @@ windows in which the joint turned. An :class:`IndexModel` chooses how to read th
   act only on a turning joint, so the still windows of a joint that turns a quarter of the time
   dilute its evidence fourfold), or, where the model names friction or backlash on the joint,
   that mode's own ``channel`` in severity units (:mod:`robohealth_mj.prognostics.channels`: the
-  window model's severity head levels off for these two modes, the channels do not);
-- ``calibration``: one isotonic map to severity for every joint (``pooled``), one per ``joint``,
+  window model's severity head levels off for these two modes, the channels do not); or the
+  channels alone through the four modes' signatures (:mod:`robohealth_mj.prognostics.signature`):
+  ``signature`` (where the channels' call of the mode is sure, they name it and read its
+  severity; elsewhere the ``channel`` form) or ``signature_named`` (the window model names the
+  mode, the channels read its severity);
+- ``calibration``: none (``none``: for the raw forms already in severity units), one isotonic
+  map to severity for every joint (``pooled``), one per ``joint``,
   one per mechanical ``mode`` the model attributes most to the joint, or one per mode and joint
   (``mode_joint``, falling back to the mode's map, then the pooled one, where a cell had too few
   calibration days);
@@ -33,9 +38,11 @@ import numpy as np
 
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.prognostics.health import Calibration, monotone_index
+from robohealth_mj.prognostics.signature import Signatures
 
 MIN_CELL_DAYS = 30  # calibration days below which a cell uses the coarser map
-RAWS, CALIBRATIONS = ("all", "moving", "channel"), ("pooled", "joint", "mode", "mode_joint")
+RAWS = ("all", "moving", "channel", "signature", "signature_named")
+CALIBRATIONS = ("none", "pooled", "joint", "mode", "mode_joint")
 CHANNEL_MODES = (1, 0)  # positions in MECHANICAL_CLASSES of friction and backlash
 
 
@@ -78,25 +85,63 @@ def session_reading(by_mode: np.ndarray, moved: np.ndarray) -> dict[str, list]:
     }
 
 
-def raw_of(day: dict, model: IndexModel, scales: np.ndarray | None = None) -> np.ndarray:
-    """``[J]`` the day's raw index under ``model.raw``: over every window; over the windows the
-    joint turned in (a joint that never turned falls back to every window); or, where the
-    model names friction or backlash on a joint, that mode's own channel in severity units
-    (``day["channel"] [2, J]`` over ``scales [2, J]``; :mod:`.channels`)."""
-    raw = np.asarray(day["raw"], float)
+@dataclass(frozen=True)
+class ChannelFits:
+    """What the recorded channels were fitted to: friction's and backlash's ``scales [2, J]``
+    (the reading per unit severity; raw ``channel``) and the four modes' ``signatures`` (raw
+    ``signature`` and ``signature_named``)."""
+
+    scales: np.ndarray | None = None
+    signatures: Signatures | None = None
+
+    def serve(self, raw: str) -> bool:
+        """Whether a raw form can be read through these fits."""
+        needs_scales = raw in ("channel", "signature")
+        needs_signatures = raw.startswith("signature")
+        return (self.scales is not None or not needs_scales) and (
+            self.signatures is not None or not needs_signatures
+        )
+
+
+NO_CHANNELS = ChannelFits()
+
+
+def reading(
+    day: dict, model: IndexModel, fits: ChannelFits = NO_CHANNELS
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(raw [J], mode [J])``: the day's raw index under ``model.raw`` and the mechanical mode
+    it is read as (calibrated per mode under ``mode`` calibrations). Raw forms: over every
+    window; over the windows the joint turned in (a joint that never turned falls back to every
+    window); where the model names friction or backlash on a joint, that mode's own channel in
+    severity units (``day["channel"]`` over ``fits.scales``); the signatures' mode and severity
+    where the channels' call is sure, else that channel form (``signature``); or the signatures'
+    severity of the mode the model names (``signature_named``). A joint the channels could not
+    read keeps the reading over the windows it turned in."""
+    raw, named = np.asarray(day["raw"], float), mode_of(day)
     if model.raw == "all":
-        return raw
+        return raw, named
     moving = np.asarray(day["raw_moving"], float)  # None reads as NaN
     out = np.where(np.isfinite(moving), moving, raw)
-    if model.raw == "channel":
-        if scales is None:
-            raise InputError("index model raw=channel needs the channels' scales")
-        units = np.asarray(day["channel"], float) / np.asarray(scales, float)
-        named = mode_of(day)
+    if model.raw == "moving":
+        return out, named
+    channel = np.asarray(day["channel"], float)
+    if model.raw in ("channel", "signature"):
+        if fits.scales is None:
+            raise InputError(f"index model raw={model.raw} needs the channels' scales")
+        units = channel[: len(fits.scales)] / np.asarray(fits.scales, float)
         for k, mode in enumerate(CHANNEL_MODES):
             use = (named == mode) & np.isfinite(units[k])
             out[use] = np.clip(units[k][use], 0.0, 1.5)
-    return out
+        if model.raw == "channel":
+            return out, named
+    if fits.signatures is None:
+        raise InputError(f"index model raw={model.raw} needs the channels' signatures")
+    if model.raw == "signature":  # the channels' call where it is sure, else the channel form
+        called, severity, sure = fits.signatures.call(channel)
+        sure &= np.isfinite(severity)
+        return np.where(sure, severity, out), np.where(sure, called, named)
+    severity = fits.signatures.read(channel, named)
+    return np.where(np.isfinite(severity), severity, out), named
 
 
 def mode_of(day: dict) -> np.ndarray:
@@ -107,6 +152,7 @@ def mode_of(day: dict) -> np.ndarray:
 def cell_keys(calibration: str, mode: int, joint: int) -> list[str]:
     """The maps a joint's reading tries, finest first (the pooled map is the last resort)."""
     return {
+        "none": [],
         "pooled": [],
         "joint": [f"j{joint}"],
         "mode": [f"m{mode}"],
@@ -122,13 +168,12 @@ class FittedIndex:
     model: IndexModel
     pooled: Calibration
     cells: dict[str, Calibration] = field(default_factory=dict)
-    scales: np.ndarray | None = None  # [2, J] the channels' reading per unit severity
+    channels: ChannelFits = field(default_factory=ChannelFits)
 
     def calibrate(self, day: dict) -> np.ndarray:
         """``[J]`` one day's calibrated index (before any monotone reading)."""
-        raw = raw_of(day, self.model, self.scales)
+        raw, modes = reading(day, self.model, self.channels)
         out = self.pooled(raw)
-        modes = mode_of(day)
         for j in range(len(raw)):
             keys = cell_keys(self.model.calibration, int(modes[j]), j)
             cal = next((self.cells[k] for k in keys if k in self.cells), None)
@@ -158,11 +203,13 @@ class FittedIndex:
         )
 
     def to_json(self) -> dict[str, Any]:
+        scales, signatures = self.channels.scales, self.channels.signatures
         return {
             "index_model": asdict(self.model),
             **asdict(self.pooled),
             "cells": {k: asdict(c) for k, c in self.cells.items()},
-            "channel_scales": None if self.scales is None else np.round(self.scales, 8).tolist(),
+            "channel_scales": None if scales is None else np.round(scales, 8).tolist(),
+            "signatures": None if signatures is None else signatures.to_json(),
         }
 
     @classmethod
@@ -180,26 +227,33 @@ class FittedIndex:
             scales = None if scales is None else np.asarray(scales, float).reshape(2, -1)
         except (TypeError, ValueError, KeyError, AttributeError) as exc:
             raise InputError(f"{path}: not a health index file ({exc})") from None
-        if model.raw == "channel" and scales is None:
-            raise InputError(f"{path}: index model raw=channel without channel_scales")
-        return cls(model, pooled, cells, scales)
+        signatures = data.get("signatures")
+        if signatures is not None:
+            signatures = Signatures.from_json(signatures, f"{path}: signatures")
+        if model.raw in ("channel", "signature") and scales is None:
+            raise InputError(f"{path}: index model raw={model.raw} without channel_scales")
+        if model.raw.startswith("signature") and signatures is None:
+            raise InputError(f"{path}: index model raw={model.raw} without signatures")
+        return cls(model, pooled, cells, ChannelFits(scales, signatures))
 
 
 def fit_index(
-    model: IndexModel, days: Iterable[dict], scales: np.ndarray | None = None
+    model: IndexModel, days: Iterable[dict], channels: ChannelFits = NO_CHANNELS
 ) -> FittedIndex:
     """Fit ``model``'s maps on ``days`` (each with ``truth [J]`` beside its raw forms); a cell
-    needs :data:`MIN_CELL_DAYS` joint-days, some of them worn. ``scales``: the channels' (raw
-    ``channel``)."""
+    needs :data:`MIN_CELL_DAYS` joint-days, some of them worn. ``channels``: what the channel
+    raw forms read through."""
     raws, truths, groups = [], [], []
     for d in days:
-        raw, modes = raw_of(d, model, scales), mode_of(d)
+        raw, modes = reading(d, model, channels)
         for j in range(len(raw)):
             raws.append(raw[j])
             truths.append(d["truth"][j])
             groups.append(cell_keys(model.calibration, int(modes[j]), j))
     raws, truths = np.array(raws), np.array(truths)
-    fitted = FittedIndex(model, Calibration.fit(raws, truths), scales=scales)
+    if model.calibration == "none":  # a raw form in severity units, read as it is
+        return FittedIndex(model, Calibration.identity(), channels=channels)
+    fitted = FittedIndex(model, Calibration.fit(raws, truths), channels=channels)
     for key in sorted({k for keys in groups for k in keys}):
         take = np.array([key in keys for keys in groups])
         if take.sum() >= MIN_CELL_DAYS and truths[take].max() > 0:

@@ -8,7 +8,9 @@ and day, and the warnings a maintenance planner is given on lives it never saw.
 Steps (each skipped when done): train ``--variant`` on every day of the training lives
 (``outputs/lives/<run>/model``); score every day of every life (``health_raw.json``: per joint the
 raw index, its bootstrap band, the index split by mechanical mode and over only the windows in
-which the joint turned). Then for each way of reading the index
+which the joint turned); fit the channels' scales and the four modes' signatures on the standard
+corpus and the training lives (``channel_scales.json``, ``signatures.json``). Then for each way of
+reading the index
 (``robohealth_mj/prognostics/index_model.py``): fit its calibration on the training lives' days in
 the model's validation split and the validation lives (each validation life read through the maps
 fitted without it), tune the warning's lead time and floor on the validation lives, and replay
@@ -41,10 +43,17 @@ from robohealth_mj.data.windows import joints_moved
 from robohealth_mj.learn.evaluation import score_checkpoint
 from robohealth_mj.learn.trainer import CHECKPOINT
 from robohealth_mj.prognostics import metrics
-from robohealth_mj.prognostics.channels import channel_readings, fit_scales
-from robohealth_mj.prognostics.health import mode_attribution, session_health, window_attribution
+from robohealth_mj.prognostics.channels import CHANNELS, channel_readings, fit_scales
+from robohealth_mj.prognostics.health import (
+    MECHANICAL_CLASSES,
+    mode_attribution,
+    session_health,
+    window_attribution,
+)
 from robohealth_mj.prognostics.index_model import (
+    NO_CHANNELS,
     VARIANTS,
+    ChannelFits,
     FittedIndex,
     IndexModel,
     fit_index,
@@ -58,6 +67,7 @@ from robohealth_mj.prognostics.planner import (
     replay_estimates,
 )
 from robohealth_mj.prognostics.rul import TrendRul
+from robohealth_mj.prognostics.signature import Signatures, adapt, fit_signatures
 from robohealth_mj.schema import JOINT_NAMES
 
 CORPUS = Path("outputs/corpus/lives")
@@ -156,28 +166,39 @@ def score_lives(ckpt: Path, index: dict, run_dir: Path) -> dict:
 
 
 def add_channels(scores: dict) -> None:
-    """Each day's friction and backlash channel readings per joint (the recording alone, no
-    model: :mod:`robohealth_mj.prognostics.channels`), added where the cache lacks them."""
+    """Each day's channel readings per joint (the recording alone, no model:
+    :mod:`robohealth_mj.prognostics.channels`), added where the cache lacks them."""
     for name, life in scores.items():
-        if all("channel" in d for d in life["days"]):
+        if all(len(d.get("channel", [])) == len(CHANNELS) for d in life["days"]):
             continue
         for d in life["days"]:
             x = np.load(CORPUS / name / f"day_{int(d['day']):03d}" / CACHE)["x"]
             d["channel"] = np.round(channel_readings(x, len(JOINT_NAMES)), 8).tolist()
 
 
-def channel_scales(run_dir: Path, extra: list[str]) -> np.ndarray | None:
-    """The channels' reading per unit severity, fitted on the fault episodes of the training
-    data beside the lives (``--train-also``; None without it: no channel index models)."""
-    path = run_dir / "channel_scales.json"
-    if path.is_file():
-        return np.array(json.loads(path.read_text()))
-    caches = sorted(p / CACHE for pattern in extra for p in Path().glob(pattern))
+def channel_fits(run_dir: Path, extra: list[str], scores: dict) -> ChannelFits:
+    """What the channel index models read through, fitted on the training data beside the lives
+    (``--train-also``; none without it): friction's and backlash's scales and the four modes'
+    signatures, these brought to whole days on the training lives (the channels, not the window
+    model: no validation or held-out life is seen). Written to the run; a rerun reads them."""
+    scales_path, signatures_path = run_dir / "channel_scales.json", run_dir / "signatures.json"
+    if scales_path.is_file() and signatures_path.is_file():
+        signatures = json.loads(signatures_path.read_text())
+        return ChannelFits(np.array(json.loads(scales_path.read_text())),
+                           Signatures.from_json(signatures, str(signatures_path)))  # fmt: skip
+    caches = [c for pattern in extra for p in sorted(Path().glob(pattern))
+              if (c := p / CACHE).is_file()]  # fmt: skip
     if not caches:
-        return None
-    scales = np.round(fit_scales([c for c in caches if c.is_file()], len(JOINT_NAMES)), 8)
-    atomic_write_json(path, scales.tolist())
-    return scales  # as written, so that a rerun reading the file reads the same numbers
+        return ChannelFits()
+    scales = np.round(fit_scales(caches, len(JOINT_NAMES)), 8)
+    days = [(np.asarray(d["channel"], float), np.asarray(d["truth"], float),
+             MECHANICAL_CLASSES.index(life["mode"]) if life["mode"] else -1)
+            for life in lives_of(scores, (TRAIN,)) for d in life["days"]]  # fmt: skip
+    signatures = adapt(fit_signatures(caches, len(JOINT_NAMES)), days).to_json()
+    atomic_write_json(scales_path, scales.tolist())
+    atomic_write_json(signatures_path, signatures)
+    # as written, so that a rerun reading the files reads the same numbers
+    return ChannelFits(scales, Signatures.from_json(signatures, str(signatures_path)))
 
 
 def calibration_days(ckpt: Path, scores: dict) -> list[dict]:
@@ -309,18 +330,18 @@ def tune_warning(views: list[LifeView], band=DEFAULT_BAND) -> dict:
 
 
 def fitted_indexes(
-    model: IndexModel, scores: dict, cal_days: list[dict], scales: np.ndarray | None
+    model: IndexModel, scores: dict, cal_days: list[dict], channels: ChannelFits
 ) -> dict[str, FittedIndex]:
     """The index each life is read through. Maps are fitted on the training lives' validation
     days and the validation lives; a validation life is read through the maps fitted without it
     (leave one life out), so that the choices made on the validation lives see out-of-sample
     readings; every other life through the maps fitted on all of them."""
     val = lives_of(scores, GROUPS["validation"])
-    full = fit_index(model, cal_days + [d for life in val for d in life["days"]], scales)
+    full = fit_index(model, cal_days + [d for life in val for d in life["days"]], channels)
     out = {name: full for name in scores}
     for life in val:
         others = [d for other in val if other is not life for d in other["days"]]
-        out[life["name"]] = fit_index(model, cal_days + others, scales)
+        out[life["name"]] = fit_index(model, cal_days + others, channels)
     out["_all"] = full
     return out
 
@@ -330,10 +351,10 @@ def evaluate_variant(
     scores: dict,
     cal_days: list[dict],
     est: TrendRul,
-    scales: np.ndarray | None = None,
+    channels: ChannelFits = NO_CHANNELS,
 ) -> dict:
     """Fit, tune on the validation lives, report on every group of lives."""
-    indexes = fitted_indexes(model, scores, cal_days, scales)
+    indexes = fitted_indexes(model, scores, cal_days, channels)
     views = {name: [view(life, indexes[life["name"]], est) for life in lives_of(scores, roles)]
              for name, roles in GROUPS.items()}  # fmt: skip
     tuned = tune_warning(views["validation"])
@@ -447,11 +468,11 @@ def main() -> None:
     for name, life in scores.items():
         life["name"] = name
     add_channels(scores)
-    scales = channel_scales(run_dir, data[1:])
+    channels = channel_fits(run_dir, data[1:], scores)
     cal_days = calibration_days(ckpt, scores)
     trend = TrendRul(threshold=threshold)
-    variants = [m for m in VARIANTS if m.raw != "channel" or scales is not None]
-    rows = [evaluate_variant(m, scores, cal_days, trend, scales)
+    variants = [m for m in VARIANTS if channels.serve(m.raw)]
+    rows = [evaluate_variant(m, scores, cal_days, trend, channels)
             for m in tqdm(variants, desc="index models", disable=None)]  # fmt: skip
     chosen = max(rows, key=selection_key)
     estimators = {"trend": trend}

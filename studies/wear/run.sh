@@ -31,7 +31,7 @@ if part planner; then
   $PY -m robohealth_mj.report --lives outputs/lives/planner_s42/lives.json \
       --out outputs/lives/planner_s42/figures
   cp outputs/lives/planner_s42/figures/life_fresh_lives_00_seed6000.png \
-      studies/wear/results/figures/planner_s42_fresh_backlash_wrist1.png
+      studies/wear/results/figures/signature_s42_fresh_backlash_wrist1.png  # the first pass's: planner_s42_*
 fi
 part severity || exit 0
 # the severity head on the standard held-out session: trained and scored with each label rule

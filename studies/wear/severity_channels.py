@@ -7,7 +7,10 @@ against (a) the health index the run's chosen index model reads (the daily readi
 monitor's monotone reading on the last day) and (b) the day's mean of the one
 recorded channel each mechanical mode acts on, on the wearing joint while it turns: friction adds
 a torque against the motion (``effort_residual`` x sign(``vel``)); a backlash gap lets the link
-lag its target (RMS ``pos_error``). Per mode: the rank correlation of each with the severity over
+lag its target (RMS ``pos_error``); and (c) the four modes' signatures
+(:mod:`robohealth_mj.prognostics.signature`): the severity they read with the life's mode named
+(monotone, as the monitor reads it), and how often they name that mode themselves on days worn
+past 0.1. Per mode: the rank correlation of (a) and (b) with the severity over
 the life's days, and the linear correlation (how nearly a straight line), means over lives; for
 the index, the share of the severity range it spans
 (the last day's reading over the truth's). A channel that keeps rising where the index levels off
@@ -25,8 +28,9 @@ import campaign  # this folder's lives campaign: the runs' cached scores and cha
 import numpy as np
 
 from robohealth_mj.prognostics.channels import MODES
-from robohealth_mj.prognostics.health import monotone_index
+from robohealth_mj.prognostics.health import MECHANICAL_CLASSES, monotone_index
 from robohealth_mj.prognostics.index_model import FittedIndex
+from robohealth_mj.prognostics.signature import SPEED
 from robohealth_mj.reporting.markdown import heading
 from robohealth_mj.schema import JOINT_NAMES
 
@@ -49,11 +53,12 @@ def main() -> None:
     ap.add_argument("run", type=Path)
     ap.add_argument("--standard", default="outputs/corpus/standard", type=Path)
     args = ap.parse_args()
-    scores = {k: v for k, v in json.loads((args.run / "health_raw.json").read_text()).items()
-              if v["role"] in GROUPS and v["joint"]}  # fmt: skip
-    campaign.add_channels(scores)
+    every = json.loads((args.run / "health_raw.json").read_text())
+    campaign.add_channels(every)
+    fits = campaign.channel_fits(args.run, [f"{args.standard}/train_*"], every)
+    scales = fits.scales
+    scores = {k: v for k, v in every.items() if v["role"] in GROUPS and v["joint"]}
     index = FittedIndex.load(args.run / "calibration.json")
-    scales = campaign.channel_scales(args.run, [f"{args.standard}/train_*"])
     rows: dict[str, list] = defaultdict(list)
     for life in scores.values():
         j = JOINT_NAMES.index(life["joint"])
@@ -72,6 +77,17 @@ def main() -> None:
             row |= {"channel_rho": spearman(readings[ok], truth[ok]),
                     "channel_r": pearson(readings[ok], truth[ok]),
                     "channel_mae": float(np.abs(reading - truth).mean())}  # fmt: skip
+        if fits.signatures is not None:  # the four modes' signatures: the mode known, and called
+            m = MECHANICAL_CLASSES.index(life["mode"])
+            named = np.full(len(JOINT_NAMES), m)
+            read = np.array([fits.signatures.read(np.asarray(d["channel"]), named)[j]
+                             for d in life["days"]])  # fmt: skip
+            read = np.nan_to_num(read)
+            mono = np.array([monotone_index(read[: k + 1])[-1] for k in range(len(read))])
+            called = [fits.signatures.call(np.asarray(d["channel"]))[0][j] == m
+                      for d, t in zip(life["days"], truth, strict=True) if t > 0.1]  # fmt: skip
+            row |= {"signature_mae": float(np.abs(mono - truth).mean()),
+                    "signature_called": float(np.mean(called)) if called else np.nan}  # fmt: skip
         rows[life["mode"]].append(row)
     head = [
         "mode",
@@ -80,6 +96,8 @@ def main() -> None:
         "monitor's index: MAE; last day / truth",
         "channel: rank / linear corr.",
         "channel in severity units: MAE",
+        "signature, mode known: MAE",
+        "signature names the mode (worn > 0.1)",
     ]
     chosen = json.loads((args.run / "lives.json").read_text())["chosen"]
     print(f"Run {args.run} ({chosen}); channel scales (reading per unit severity, per joint):")
@@ -100,7 +118,24 @@ def main() -> None:
                 if has
                 else "— | — |"
             )
+            + (
+                f" {mean(v, 'signature_mae'):.3f} | {mean(v, 'signature_called'):.2f} |"
+                if fits.signatures is not None
+                else " — | — |"
+            )
         )
+
+    if fits.signatures is not None:
+        speeds = np.nanmedian([np.asarray(d["channel"], float)[SPEED] for life in scores.values()
+                               for d in life["days"]], axis=0)  # fmt: skip
+        print()
+        title = "How far each mode moves its channels, in healthy day-to-day spreads"
+        print("\n".join(heading(title, ["mode", "severity", *JOINT_NAMES])))
+        for severity in (0.3, 1.0):
+            size = fits.signatures.size(severity, speeds)
+            for m, mode in enumerate(MECHANICAL_CLASSES):
+                cells = " | ".join(f"{v:.0f}" for v in size[m])
+                print(f"| {mode} | {severity:g} | {cells} |")
 
 
 if __name__ == "__main__":

@@ -39,11 +39,11 @@ def main() -> None:
         chosen = json.loads((run / "lives.json").read_text())["chosen"]
         model = next(m for m in VARIANTS if m.name == chosen)
         c.add_channels(scores)
-        scales = c.channel_scales(run, [])  # the run's, fitted when it ran
+        channels = c.channel_fits(run, [], scores)  # the run's, fitted when it ran
         cal_days = c.calibration_days(run / "model" / "best.ckpt", scores)
         for window in WINDOWS:
             est = TrendRul(threshold=0.8, window=window)
-            row = c.evaluate_variant(model, scores, cal_days, est, scales)
+            row = c.evaluate_variant(model, scores, cal_days, est, channels)
             g, w = row["groups"], row["warning"]
             cells = [
                 run.name, chosen, window, f"{w['lead_days']:g}, {w['floor']:g}",

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.prognostics.health import Calibration
 from robohealth_mj.prognostics.index_model import (
     FittedIndex,
     IndexModel,
@@ -87,3 +88,19 @@ def test_a_mode_that_over_reads_and_one_that_under_reads_are_each_mapped_back():
     assert abs(pooled.calibrate(over)[0] - pooled.calibrate(under)[0]) > 0.05
     assert by_mode.calibrate(over)[0] == pytest.approx(0.3, abs=0.05)
     assert by_mode.calibrate(under)[0] == pytest.approx(0.3, abs=0.05)
+
+
+def test_a_reading_that_is_zero_on_most_days_is_still_mapped_over_its_worn_range():
+    """Most joint-days of a channel reading are healthy and read exactly 0; the map's knots must
+    still spread over the worn readings (here the truth is the reading squared)."""
+    raw = np.concatenate([np.zeros(900), np.linspace(0.01, 1.0, 100)])
+    truth = np.concatenate([np.zeros(900), np.linspace(0.01, 1.0, 100) ** 2])
+    cal = Calibration.fit(raw, truth)
+    assert cal(0.5) == pytest.approx(0.25, abs=0.05) and cal(0.9) == pytest.approx(0.81, abs=0.05)
+    assert cal(0.0) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_an_index_in_severity_units_can_be_read_without_a_map():
+    days = _days()
+    fitted = fit_index(IndexModel("all", "none"), days)
+    assert fitted.calibrate(days[0]) == pytest.approx(np.clip(days[0]["raw"], 0, 1))

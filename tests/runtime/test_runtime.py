@@ -17,6 +17,9 @@ from robohealth_mj.deploy.alarm_sweep import evaluate_policy, replay_decisions, 
 from robohealth_mj.deploy.export import RawInput, export_checkpoint, read_metadata
 from robohealth_mj.learn.checkpoint import load_checkpoint, model_from_checkpoint
 from robohealth_mj.monitor import main as monitor_main
+from robohealth_mj.prognostics.channels import CHANNELS
+from robohealth_mj.prognostics.health import MECHANICAL_CLASSES
+from robohealth_mj.prognostics.signature import Signatures
 from robohealth_mj.runtime.alarms import CLEARED, HELD, RAISED
 from robohealth_mj.runtime.fleet import DECIDED, FleetRuntime
 from robohealth_mj.runtime.online_eval import OnlineEvaluator
@@ -437,7 +440,8 @@ def test_monitor_reads_the_index_through_a_fitted_index_file(deployed, tmp_path)
     """``health.calibration``: a fitted index (studies/wear) with a map for the elbow alone; the
     session's elbow index is that map's reading, the other joints the pooled map's. An index that
     reads friction and backlash from the joints' own channels gets them from the session's
-    samples: on a healthy arm they read near zero wherever the model names those modes."""
+    samples: on a healthy arm they read near zero wherever the model names those modes, and so
+    do the four modes' signatures."""
 
     def healthy_day(name: str, index: dict) -> list[float]:
         (tmp_path / f"{name}.json").write_text(json.dumps(index))
@@ -469,6 +473,16 @@ def test_monitor_reads_the_index_through_a_fitted_index_file(deployed, tmp_path)
         "channel_scales": [[10.0] * 6, [0.01] * 6],
     })  # fmt: skip
     assert np.isfinite(read).all() and max(read) < 0.2
+    c, m = len(CHANNELS), len(MECHANICAL_CLASSES)
+    response = np.zeros((m, c, 6, 4))
+    response[:, CHANNELS.index("friction"), :, 0] = 10.0  # every mode: 10 N m per unit severity
+    signed = healthy_day("signature", {
+        "index_model": {"raw": "signature", "calibration": "pooled", "monotone": False},
+        "x": [0.0, 1.0], "y": [0.0, 1.0], "cells": {}, "channel_scales": [[10.0] * 6, [0.01] * 6],
+        "signatures": Signatures(np.zeros((c, 6, 3)), np.full((c, 6), 0.5), response,
+                                 np.ones((m, c), bool), detect=16.0).to_json(),
+    })  # fmt: skip
+    assert np.isfinite(signed).all() and max(signed) < 0.2
 
 
 def test_monitor_health_without_a_day_is_one_line(deployed, tmp_path, capsys):
