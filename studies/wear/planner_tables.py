@@ -112,16 +112,44 @@ def strata(runs: list[dict]) -> list[str]:
     return lines
 
 
+def observable(runs: list[dict], unobservable: list[tuple[str, str]]) -> list[str]:
+    """The chosen index's wearing-joint MAE (every day of every life weighs the same) with and
+    without the lives of the (mode, joint) pairs no channel can read (argued from the channels'
+    response in ``severity_channels.md``)."""
+    head = ["seed", "group", "wearing-joint MAE", "lives left out", "MAE without them"]
+    pairs = ", ".join(f"{m} at {j}" for m, j in unobservable) or "none"
+    lines = heading(
+        f"The wearing-joint MAE on what the channels can read (left out: {pairs})", head
+    )
+    for run in runs:
+        for g in ("held_out", "fresh"):
+            rows = [r for r in run["rul"] if r["group"] == g and r["estimator"] == "trend"]
+            keep = [r for r in rows if (r["mode"], r["joint"]) not in unobservable]
+            err = lambda rs: np.abs(np.concatenate([np.subtract(r["index"], r["truth"])  # noqa: E731
+                                                    for r in rs])).mean()  # fmt: skip
+            cells = [str(run["seed"]), g, f"{err(rows):.3f}", str(len(rows) - len(keep)),
+                     f"{err(keep):.3f}" if keep else "—"]  # fmt: skip
+            lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", type=Path)
+    ap.add_argument(
+        "--unobservable",
+        default="",
+        help="mode:joint pairs no channel can read, comma-separated (struct_weaken:shoulder_pan)",
+    )
     args = ap.parse_args()
+    unobservable = [tuple(pair.split(":", 1)) for pair in args.unobservable.split(",") if pair]
     runs = [json.loads(p.read_text()) for p in args.runs]
     print("\n".join(["# Wear figures a planner can trust (issue 68)", "",
                      f"Runs: {', '.join(str(p) for p in args.runs)}. Band: "
                      f"{runs[0]['band_days'][0]:g}-{runs[0]['band_days'][1]:g} days before "
                      "failure, the first warning on any joint.", "",
-                     *targets(runs), "", *ablation(runs), "", *strata(runs), "",
+                     *targets(runs), "", *observable(runs, unobservable), "", *ablation(runs), "",
+                     *strata(runs), "",
                      *per_life(runs)]))  # fmt: skip
 
 
