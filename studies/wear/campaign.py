@@ -76,10 +76,11 @@ HELD_OUT, TRAIN, HEALTHY = "heldout_lives", "train_lives", "healthy_lives"
 CACHE = "graphs.jsonl" + CACHE_SUFFIX  # a recording's binary cache
 VAL, VAL_WIDE = "val_lives", "val_wide_lives"  # never trained on: where the index is calibrated
 # and the index model and the warning chosen (val_wide_lives drawn as the held-out lives are)
+VAL_HEALTHY = "val_healthy_lives"  # and where those choices see healthy-day warnings
 FRESH, FRESH_HEALTHY = "fresh_lives", "fresh_healthy_lives"  # seeds no choice ever saw
-ROLES = (TRAIN, VAL, VAL_WIDE, HELD_OUT, HEALTHY, FRESH, FRESH_HEALTHY)
+ROLES = (TRAIN, VAL, VAL_WIDE, VAL_HEALTHY, HELD_OUT, HEALTHY, FRESH, FRESH_HEALTHY)
 GROUPS = {
-    "validation": (VAL, VAL_WIDE),
+    "validation": (VAL, VAL_WIDE, VAL_HEALTHY),
     "held_out": (HELD_OUT, HEALTHY),
     "fresh": (FRESH, FRESH_HEALTHY),
 }

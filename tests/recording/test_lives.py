@@ -26,6 +26,7 @@ TINY = [  # two wearing lives of a few 3-second days, one healthy life of two da
     "~corpus.roles.heldout_lives",
     "~corpus.roles.val_lives",
     "~corpus.roles.val_wide_lives",
+    "~corpus.roles.val_healthy_lives",
     "~corpus.roles.fresh_lives",
     "~corpus.roles.fresh_healthy_lives",
 ]
