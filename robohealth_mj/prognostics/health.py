@@ -67,20 +67,25 @@ def attribution_from_probabilities(
     return mode_probabilities(p_class, p_joint, severity).sum(axis=1)
 
 
-def isotonic(values: np.ndarray) -> np.ndarray:
-    """The non-decreasing sequence nearest ``values [S]`` in least squares (pool adjacent
-    violators)."""
+def isotonic(values: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
+    """The non-decreasing sequence nearest ``values [S]`` in (``weights``-weighted) least
+    squares (pool adjacent violators)."""
+    v = np.asarray(values, float)
+    w_in = np.ones(len(v)) if weights is None else np.asarray(weights, float)
     level: list[float] = []
-    weight: list[int] = []
-    for value in np.asarray(values, float):
+    weight: list[float] = []
+    count: list[int] = []
+    for value, w in zip(v, w_in, strict=True):
         level.append(float(value))
-        weight.append(1)
+        weight.append(float(w))
+        count.append(1)
         while len(level) > 1 and level[-2] > level[-1]:
-            w = weight[-2] + weight[-1]
-            level[-2] = (level[-2] * weight[-2] + level[-1] * weight[-1]) / w
-            weight[-2] = w
-            level.pop(), weight.pop()
-    return np.repeat(level, weight)
+            total = weight[-2] + weight[-1]
+            level[-2] = (level[-2] * weight[-2] + level[-1] * weight[-1]) / total
+            weight[-2] = total
+            count[-2] += count[-1]
+            level.pop(), weight.pop(), count.pop()
+    return np.repeat(level, count)
 
 
 def monotone_index(history: np.ndarray) -> np.ndarray:
@@ -120,14 +125,15 @@ class Calibration:
 
     @classmethod
     def fit(cls, raw: np.ndarray, truth: np.ndarray, knots: int = 12) -> Calibration:
-        """Isotonic regression of ``truth`` on ``raw`` (pool-adjacent-violators), thinned to at
-        most ``knots`` points at the quantiles of the raw index's distinct values (a raw form
-        that reads most joint-days as exactly 0 would otherwise put every knot there)."""
-        order = np.argsort(raw, kind="stable")
+        """Isotonic regression of ``truth`` on ``raw`` (pool-adjacent-violators over the distinct
+        raw values, each its days' mean weighted by their number, so that the order of the days
+        does not matter), thinned to at most ``knots`` points at the quantiles of the distinct
+        values (a raw form that reads most joint-days as exactly 0 would otherwise put every
+        knot there)."""
+        order = np.lexsort((np.asarray(truth, float), np.asarray(raw, float)))
         xs, ys = np.asarray(raw, float)[order], np.asarray(truth, float)[order]
-        fitted = isotonic(ys)
-        ux, first = np.unique(xs, return_index=True)
-        uy = np.add.reduceat(fitted, first) / np.diff(np.append(first, len(xs)))
+        ux, first, counts = np.unique(xs, return_index=True, return_counts=True)
+        uy = isotonic(np.add.reduceat(ys, first) / counts, counts)
         picks = np.unique(np.linspace(0, len(ux) - 1, knots).round().astype(int))
         return cls(ux[picks].round(6).tolist(), np.clip(uy[picks], 0.0, 1.0).round(6).tolist())
 

@@ -119,8 +119,8 @@ def _manifest_run_id(session: Path) -> str:
 
 
 def score_lives(ckpt: Path, index: dict, run_dir: Path) -> dict:
-    """Per life: each day's raw index, band and truth per joint (cached; a life the cache lacks,
-    such as a role added to the corpus later, is scored and added)."""
+    """Per life, in name order: each day's raw index, band and truth per joint (cached; a life
+    the cache lacks, such as a role added to the corpus later, is scored and added)."""
     cache = run_dir / "health_raw.json"
     out = json.loads(cache.read_text()) if cache.is_file() else {}
     todo = [(role, entry) for role in ROLES for entry in index["roles"].get(role, [])
@@ -163,7 +163,7 @@ def score_lives(ckpt: Path, index: dict, run_dir: Path) -> dict:
         }
         print(f"scored {entry['dir']}: {len(days)} days", flush=True)
     atomic_write_json(cache, out)
-    return out
+    return dict(sorted(out.items()))  # as the cache reads back: a rerun meets the lives in order
 
 
 def add_channels(scores: dict) -> None:
