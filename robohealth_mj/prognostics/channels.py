@@ -11,12 +11,13 @@ held-out and fresh lives, ``studies/wear/severity_channels.py``):
 
 A reading divided by its (mode, joint)'s *scale*, the reading per unit severity fitted as a line
 through the origin on labelled fault episodes (the standard corpus holds every pair at 0.3, 0.6
-and 0.9), is in severity units. Five more channels, read the same way, carry the other two
-modes and tell the four apart (:mod:`robohealth_mj.prognostics.signature`): the residual's
-spread (a jam's torque impulses), the lag signed against the motion, the lag per unit drive
-torque (a softer drive), and the joint's sensor package's vibration overall and in its highest
-band (the impacts of a gap or a catching gear). :class:`ChannelSums` accumulates a session tick
-by tick, as the monitor sees it. NumPy only.
+and 0.9), is in severity units. Six more channels carry the other two modes and tell the four
+apart (:mod:`robohealth_mj.prognostics.signature`): the residual's spread (a jam's torque
+impulses), the lag signed against the motion, a dead zone and a compliance fitted together to
+the lag against the drive torque (a gap against a softer drive), and the joint's sensor
+package's vibration overall and in its highest band (the knocks of a gap or a catching gear);
+the joint's speed rides along, as the duty the others depend on. :class:`ChannelSums`
+accumulates a session tick by tick, as the monitor sees it. NumPy only.
 """
 
 from __future__ import annotations
