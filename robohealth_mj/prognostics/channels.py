@@ -22,7 +22,7 @@ accumulates a session tick by tick, as the monitor sees it. NumPy only.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -103,25 +103,34 @@ def channel_readings(x: np.ndarray, n_joints: int) -> np.ndarray:
     return sums.readings()
 
 
+def labelled_stretches(
+    session: Path, n_joints: int, min_ticks: int = 1
+) -> Iterator[tuple[int, int, float, np.ndarray]]:
+    """``(fault class, joint, severity, readings [C, J])`` per labelled stretch of a recording's
+    binary cache (consecutive samples with one class, joint and severity; at least
+    ``min_ticks`` of them)."""
+    z = np.load(session)
+    x, cls, joint, sev = z["x"], z["fault_class"], z["fault_joint"], z["severity"]
+    key = np.stack([cls, joint, np.round(sev * 1000)], axis=1)
+    change = np.flatnonzero((np.diff(key, axis=0) != 0).any(axis=1)) + 1
+    for start, end in zip(np.r_[0, change], np.r_[change, len(cls)], strict=True):
+        if end - start >= min_ticks:
+            readings = channel_readings(x[start:end], n_joints)
+            yield int(cls[start]), int(joint[start]), float(sev[start]), readings
+
+
 def fit_scales(sessions: Iterable[Path], n_joints: int) -> np.ndarray:
     """``[2, J]`` each (mode, joint)'s reading per unit severity: a line through the origin over
     the fault episodes of ``sessions`` (binary caches of labelled recordings)."""
     num = np.zeros((len(MODES), n_joints))
     den = np.zeros((len(MODES), n_joints))
     for session in sessions:
-        z = np.load(session)
-        x, cls, joint, sev = z["x"], z["fault_class"], z["fault_joint"], z["severity"]
-        for m, mode in enumerate(MODES):
-            for j in range(n_joints):
-                mine = (cls == FAULT_CLASSES.index(mode)) & (joint == j) & (sev > 0)
-                if not mine.any():
-                    continue
-                edges = np.flatnonzero(np.diff(np.concatenate([[0], mine.astype(int), [0]])))
-                for start, end in zip(edges[::2], edges[1::2], strict=True):
-                    reading = channel_readings(x[start:end], n_joints)[m, j]
-                    if np.isfinite(reading):
-                        s = float(sev[start])
-                        num[m, j] += reading * s
-                        den[m, j] += s * s
+        for cls, j, s, readings in labelled_stretches(session, n_joints):
+            if FAULT_CLASSES[cls] not in MODES:  # a healthy stretch (severity 0) adds nothing
+                continue
+            m = MODES.index(FAULT_CLASSES[cls])
+            if np.isfinite(readings[m, j]):
+                num[m, j] += readings[m, j] * s
+                den[m, j] += s * s
     with np.errstate(invalid="ignore", divide="ignore"):
         return num / den

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.prognostics.channels import CHANNELS, channel_readings
+from robohealth_mj.prognostics.channels import CHANNELS, labelled_stretches
 from robohealth_mj.prognostics.health import MECHANICAL_CLASSES
 from robohealth_mj.schema import FAULT_CLASSES
 
@@ -75,10 +75,8 @@ class Signatures:
         """``[C, J]`` each reading above its healthy level at the day's speed, in spreads (NaN
         where a channel was not read)."""
         r = np.asarray(readings, float)
-        v = r[SPEED]
-        level = self.baseline[..., 0] + self.baseline[..., 1] * v + self.baseline[..., 2] * v**2
         with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(WEAR[:, None], (r - level) / self.spread, np.nan)
+            return np.where(WEAR[:, None], (r - _level(self.baseline, r)) / self.spread, np.nan)
 
     def _costs(self, readings: np.ndarray) -> tuple[np.ndarray, ...]:
         """``(cost [M, S, J], at_zero [M, J], seen [J], size [M, S, J])``: per mode and grid
@@ -205,30 +203,13 @@ def _level(baseline: np.ndarray, readings: np.ndarray) -> np.ndarray:
     return baseline[..., 0] + baseline[..., 1] * v + baseline[..., 2] * v**2
 
 
-def episodes(session: Path, n_joints: int) -> Iterable[tuple[int, int, float, np.ndarray]]:
-    """``(fault class, joint, severity, readings [C, J])`` per labelled stretch of a recording's
-    binary cache (a stretch: consecutive samples with one class, joint and severity)."""
-    z = np.load(session)
-    x, cls, joint, sev = z["x"], z["fault_class"], z["fault_joint"], z["severity"]
-    key = np.stack([cls, joint, np.round(sev * 1000)], axis=1)
-    change = np.flatnonzero((np.diff(key, axis=0) != 0).any(axis=1)) + 1
-    for start, end in zip(np.r_[0, change], np.r_[change, len(cls)], strict=True):
-        if end - start >= MIN_EPISODE_TICKS:
-            yield (
-                int(cls[start]),
-                int(joint[start]),
-                float(sev[start]),
-                channel_readings(x[start:end], n_joints),
-            )
-
-
 def fit_signatures(sessions: Iterable[Path], n_joints: int) -> Signatures:
     """Fit on labelled recordings (the standard corpus holds every mode and joint at severity
     0.3, 0.6 and 0.9): the healthy stretches' level and spread, then per (mode, joint) each
     channel's quadratic response by least squares. Every channel is read."""
     healthy, faulty = [], []
     for session in sessions:
-        for cls, joint, sev, readings in episodes(session, n_joints):
+        for cls, joint, sev, readings in labelled_stretches(session, n_joints, MIN_EPISODE_TICKS):
             if cls == FAULT_CLASSES.index("none"):
                 healthy.append(readings)
             elif FAULT_CLASSES[cls] in MECHANICAL_CLASSES and sev > 0:
