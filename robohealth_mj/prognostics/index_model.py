@@ -137,7 +137,8 @@ def reading(
     if fits.signatures is None:
         raise InputError(f"index model raw={model.raw} needs the channels' signatures")
     if model.raw == "signature":  # the channels' call where it is sure, else the channel form
-        called, severity, sure = fits.signatures.call(channel)
+        recent = day.get("recent_channel")  # the last days' readings: loads settle a sag
+        called, severity, sure = fits.signatures.call(channel, recent)
         sure &= np.isfinite(severity)
         return np.where(sure, severity, out), np.where(sure, called, named)
     severity = fits.signatures.read(channel, named)

@@ -16,7 +16,11 @@ standard corpus's short labelled episodes (every mode and joint at 0.3, 0.6 and 
 :func:`fit_signatures`); :func:`adapt` re-fits the healthy level and spread on whole operating
 days and scales each (mode, channel)'s response by what days of known wear show, keeping only
 the channels the days bear out within a factor of two (a backlash episode's vibration, for one,
-is an onset transient that days do not repeat). :meth:`Signatures.read` gives the severity of a
+is an onset transient that days do not repeat), and measures how far each (mode, channel)'s days
+stray from it, as a share of the response: a channel's misfit counts in units of one healthy
+spread plus that share of its predicted excess, so a channel whose fit swings from day to day
+(the dead zone on a gravity-loaded joint) does not outvote one that tracks the wear (the lag).
+:meth:`Signatures.read` gives the severity of a
 named mode; :meth:`Signatures.call` names the mode whose signature explains most of the excess,
 and says whether the call is sure (the runner-up explains far less).
 No window model is needed. NumPy only.
@@ -42,18 +46,31 @@ SEVERITY_GRID = np.linspace(0.0, 1.5, 151)  # the severities a reading weighs (0
 # channels a few spreads at full severity, so a healthy day's noise there would read as wear.
 SURE_SE = 0.05
 MIN_EPISODE_TICKS = 50  # shorter labelled stretches (a fault's edges) are not fitted
-SPEED = CHANNELS.index("speed")  # the covariate: every other channel is a wear channel
-WEAR = np.array([c != SPEED for c in range(len(CHANNELS))])
+SPEED, LOAD = CHANNELS.index("speed"), CHANNELS.index("load")  # covariates, not wear channels
+WEAR = np.array([c not in (SPEED, LOAD) for c in range(len(CHANNELS))])
+LAG = CHANNELS.index("lag")
+BACKLASH, SPRING = MECHANICAL_CLASSES.index("backlash"), MECHANICAL_CLASSES.index("struct_weaken")
 TRUSTED = (0.5, 2.0)  # the days' response over the episodes' for a channel to be read
 # The excess a mode must explain (squared healthy spreads) to be read as wear: on the training
 # lives' healthy joint-days the 99th-percentile reading is 0.76 with none, 0.24 at 9, 0.03 at 16.
 DETECT = 16.0
-# How much more of the excess the called mode must explain than the runner-up, as a share of its
-# own, for the call to be taken over the window model's: chosen on the validation lives (seed 42;
-# the wearing joint's raw MAE 0.105, 0.093, 0.088, 0.081, 0.085 and 0.084 at 0, 0.3, 0.5, 0.7,
-# 0.9 and never). Backlash and a softer drive at the elbow and shoulder explain each other's
-# readings nearly as well (both lag under a one-sided gravity torque): those calls are not taken.
-MARGIN = 0.7
+# How much worse the runner-up must fit the day than the called mode (twice the log-likelihood
+# ratio) for the call to be taken over the window model's: chosen on the validation lives (seed
+# 42, val_lives and val_wide_lives; the wearing joint's raw MAE 0.066, 0.060, 0.059, 0.057, 0.060
+# and 0.069 at 0, 5, 10, 20, 50 and 200). Backlash and a softer drive at a joint that carries the
+# arm's weight fit a day alike (both sag by one offset under a one-sided torque): the last days'
+# loads settle those calls (LOAD_DAYS below).
+MARGIN = 20.0
+# A gap and a softer spring make a joint that carries the arm's weight sag by one offset within a
+# day: its torque keeps its sign and varies mostly by the motor's friction, which the spring never
+# feels (studies/wear/results/load_dependence.md). From day to day the payload changes the load: a
+# gap's lag holds, a spring's follows it. Over the last LOAD_DAYS days, the smoother of the two
+# severity paths (the lag as it is, or per unit load) settles a call between the two, where the
+# loads spanned LOAD_CHANGE of their mean and one path strays at most LOAD_CLEAR as far as the
+# other (on the training and validation lives' loaded joints every such vote named the mode).
+LOAD_DAYS = 5
+LOAD_CHANGE = 0.15
+LOAD_CLEAR = 0.5
 
 
 @dataclass(frozen=True)
@@ -62,7 +79,9 @@ class Signatures:
     ``v``; ``spread [C, J]``: the healthy readings' spread about it; ``response [M, C, J, 4]``:
     the excess is ``s (r1 + r2 v) + s^2 (r3 + r4 v)`` at severity ``s`` of mode ``m``; ``use
     [M, C]``: the channels a mode is read from (modes in :data:`MECHANICAL_CLASSES` order; C over
-    :data:`CHANNELS`, the speed's rows unused); ``detect``, ``margin``: see :func:`adapt`."""
+    :data:`CHANNELS`, the speed's and load's rows unused); ``detect``, ``margin``: see
+    :func:`adapt`; ``error [M, C]``: how far a day's excess strays from the response, as a share
+    of it (None: not at all; see :func:`adapt`)."""
 
     baseline: np.ndarray
     spread: np.ndarray
@@ -70,6 +89,7 @@ class Signatures:
     use: np.ndarray
     detect: float = 0.0
     margin: float = 0.0
+    error: np.ndarray | None = None
 
     def excess(self, readings: np.ndarray) -> np.ndarray:
         """``[C, J]`` each reading above its healthy level at the day's speed, in spreads (NaN
@@ -80,14 +100,18 @@ class Signatures:
 
     def _costs(self, readings: np.ndarray) -> tuple[np.ndarray, ...]:
         """``(cost [M, S, J], at_zero [M, J], seen [J], size [M, S, J])``: per mode and grid
-        severity the squared misfit over the mode's channels, the misfit of no wear, whether any
-        channel was read, and the predicted excess's size over the channels read (in spreads)."""
+        severity the squared misfit over the mode's channels (each in units of its expected
+        scatter: one healthy spread, and :attr:`error` of the predicted excess), the misfit of
+        no wear, whether any channel was read, and the predicted excess's size over the channels
+        read, in healthy spreads (how far a healthy day's noise can move the read)."""
         z = self.excess(readings)  # [C, J]
         v = np.asarray(readings, float)[SPEED]
         predicted = _response(self.response[:, None], SEVERITY_GRID[:, None, None], v)
         predicted = np.nan_to_num(predicted / self.spread)  # [M, S, C, J]
+        error = np.zeros(self.use.shape) if self.error is None else self.error
+        scatter = 1.0 + (error[:, None, :, None] * predicted) ** 2  # [M, S, C, J], squared
         read = np.isfinite(z)[None] & self.use[:, :, None]  # [M, C, J]
-        miss = np.where(read[:, None], np.nan_to_num(z) - predicted, 0.0) ** 2
+        miss = np.where(read[:, None], np.nan_to_num(z) - predicted, 0.0) ** 2 / scatter
         cost = miss.sum(axis=2)
         known = np.isfinite(self.response).all(axis=(1, 3))  # [M, J]: the pairs fitted
         size = np.sqrt((np.where(read[:, None], predicted, 0.0) ** 2).sum(axis=2))  # [M, S, J]
@@ -100,27 +124,80 @@ class Signatures:
         cost, at_zero, seen, _ = self._costs(readings)
         return self._severity(cost, at_zero, seen, np.asarray(mode, int))
 
-    def call(self, readings: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(mode [J], severity [J], sure [J])``: the mode whose signature explains most of the
-        excess (the misfit of no wear less its best misfit), its severity, and whether the call
-        is sure: the mode reads its severity to within :data:`SURE_SE` per spread of noise, wear
-        was detected, the runner-up explains at most ``1 - margin`` as much, and no
-        other joint's sure call of that mode explains more (a catching gear's impulses and a
-        gap's knocks travel through the arm: the joint that shows them most is their source)."""
+    def call(
+        self, readings: np.ndarray, recent: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(mode [J], severity [J], sure [J])``: the mode whose signature fits the day best,
+        its severity, and whether the call is sure. Each mode is read at its own severity and
+        judged over every channel any mode reads (a channel it leaves unmoved counts its excess
+        against it), as a Gaussian likelihood: each misfit in units of its expected scatter, plus
+        that scatter's log, so that a mode cannot buy a loose fit by predicting a large, uncertain
+        excess. The call is sure where the runner-up fits worse by at least ``margin`` (twice the
+        log-likelihood ratio), wear was detected, the mode reads its severity to within
+        :data:`SURE_SE` per spread of noise, and no other joint's sure call of that mode explains
+        more (a catching gear's impulses and a gap's knocks travel through the arm: the joint
+        that shows them most is their source). ``recent [K, C, J]``: the last days' readings,
+        this one last: where backlash and a softer drive fit best, their loads settle the call
+        between them (:meth:`settle`) and the lead is taken over the other two modes."""
         cost, at_zero, seen, size = self._costs(readings)
-        explained = at_zero - cost.min(axis=1)  # [M, J]
-        explained = np.where(np.isfinite(explained), explained, -np.inf)
-        mode = explained.argmax(axis=0)
-        best, second = np.sort(explained, axis=0)[[-1, -2]]
+        step = cost.argmin(axis=1)  # [M, J]: each mode's severity read, on the grid
+        fit = np.where(np.isfinite(cost.min(axis=1)), self._misfit(readings, step), np.inf)
+        mode = fit.argmin(axis=0)
         j = np.arange(len(mode))
-        step = cost[mode, :, j].argmin(axis=1)  # the severity read, on the grid
+        runner_up = np.sort(fit, axis=0)[1]
+        if recent is not None:
+            settled = self.settle(recent)
+            pair = np.sort(np.argsort(fit, axis=0)[:2], axis=0)
+            tied = (settled >= 0) & (pair == np.sort([[BACKLASH], [SPRING]], axis=0)).all(axis=0)
+            mode = np.where(tied, settled, mode)
+            others = np.delete(fit, [BACKLASH, SPRING], axis=0).min(axis=0)
+            runner_up = np.where(tied, others, runner_up)
+        lead = runner_up - fit[mode, j]
+        best = (at_zero - cost.min(axis=1))[mode, j]  # the excess the call explains
+        step = step[mode, j]
         # a spread of noise moves the severity read by about severity / size
         precise = size[mode, step, j] * SURE_SE >= SEVERITY_GRID[step]
-        sure = precise & (best >= max(self.detect, 1e-12)) & (best - second > self.margin * best)
+        sure = precise & (best >= max(self.detect, 1e-12)) & (lead >= self.margin)
         for m in np.unique(mode[sure]):
             same = sure & (mode == m)
             sure &= ~same | (best >= best[same].max())
         return mode, self._severity(cost, at_zero, seen, mode), sure
+
+    def _misfit(self, readings: np.ndarray, step: np.ndarray) -> np.ndarray:
+        """``[M, J]`` each mode's misfit at its severity ``SEVERITY_GRID[step [M, J]]`` over every
+        channel any mode reads: squared misfit per expected scatter plus the scatter's log."""
+        z = self.excess(readings)  # [C, J]
+        v = np.asarray(readings, float)[SPEED]
+        severity = SEVERITY_GRID[step][:, None, :]  # [M, 1, J]
+        predicted = np.nan_to_num(_response(self.response, severity, v) / self.spread)
+        predicted *= self.use[:, :, None]  # [M, C, J]
+        error = np.zeros(self.use.shape) if self.error is None else self.error
+        scatter = 1.0 + (error[:, :, None] * predicted) ** 2
+        miss = (np.nan_to_num(z)[None] - predicted) ** 2 / scatter + np.log(scatter)
+        read = np.isfinite(z)[None] & self.use.any(axis=0)[None, :, None]
+        return np.where(read, miss, 0.0).sum(axis=1)
+
+    def settle(self, recent: np.ndarray) -> np.ndarray:
+        """``[J]`` backlash or a softer drive (their :data:`MECHANICAL_CLASSES` index) where the
+        last :data:`LOAD_DAYS` days (``recent [K, C, J]``, the latest last) tell them apart by
+        their loads, else -1: a gap's lag holds as the load changes, a spring's follows it."""
+        days = np.asarray(recent, float)[-LOAD_DAYS:]
+        out = np.full(days.shape[-1], -1)
+        if len(days) < LOAD_DAYS:
+            return out
+        lag = np.stack([self.excess(day)[LAG] for day in days])  # [K, J], in spreads
+        load = days[:, LOAD]
+        ok = (np.isfinite(lag) & np.isfinite(load) & (load > 0)).all(axis=0)
+        ok &= (np.nan_to_num(lag) >= np.sqrt(self.detect)).all(axis=0)  # well above the noise
+        if not ok.any():
+            return out
+        lag, load = lag[:, ok], load[:, ok]
+        gap, spring = _roughness(lag), _roughness(lag / load)
+        clear = (np.ptp(load, axis=0) >= LOAD_CHANGE * load.mean(axis=0)) & (
+            np.minimum(gap, spring) <= LOAD_CLEAR * np.maximum(gap, spring)
+        )
+        out[np.flatnonzero(ok)[clear]] = np.where(gap < spring, BACKLASH, SPRING)[clear]
+        return out
 
     def _severity(
         self, cost: np.ndarray, at_zero: np.ndarray, seen: np.ndarray, mode: np.ndarray
@@ -148,6 +225,7 @@ class Signatures:
             "use": self.use.astype(int).tolist(),
             "detect": self.detect,
             "margin": self.margin,
+            "error": None if self.error is None else np.round(self.error, 12).tolist(),
         }
 
     @classmethod
@@ -157,6 +235,7 @@ class Signatures:
             use = np.asarray(data["use"], int).astype(bool)
             channels = list(data["channels"])
             detect, margin = float(data["detect"]), float(data["margin"])
+            error = None if data["error"] is None else np.asarray(data["error"], float)
         except (TypeError, ValueError, KeyError) as exc:
             raise InputError(f"{where}: not a channel signature ({exc})") from None
         c, m = len(CHANNELS), len(MECHANICAL_CLASSES)
@@ -166,12 +245,13 @@ class Signatures:
             channels != list(CHANNELS)
             or j == 0
             or any(p.shape != want for p, want in zip([*parts, use], shapes, strict=True))
+            or (error is not None and error.shape != use.shape)
         ):
             raise InputError(
                 f"{where}: a signature of channels {channels} over {parts[1].shape} joints; "
                 f"this version reads {list(CHANNELS)}"
             )
-        return cls(*parts, use, detect, margin)
+        return cls(*parts, use, detect, margin, error)
 
 
 def _speed_fit(readings: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -196,6 +276,15 @@ def _response(response: np.ndarray, severity, speed) -> np.ndarray:
     """The excess ``response [..., 4]`` predicts at ``severity`` and the joint's ``speed``."""
     r = [response[..., k] for k in range(4)]
     return severity * (r[0] + r[1] * speed) + severity**2 * (r[2] + r[3] * speed)
+
+
+def _roughness(paths: np.ndarray) -> np.ndarray:
+    """``[J]`` how far each column of ``paths [K, J]`` (one value a day) strays from a straight
+    line through the days, relative to its mean."""
+    y = paths / paths.mean(axis=0)
+    t = np.arange(len(y))
+    slope, intercept = np.polyfit(t, y, 1)
+    return (y - (slope * t[:, None] + intercept)).std(axis=0)
 
 
 def _level(baseline: np.ndarray, readings: np.ndarray) -> np.ndarray:
@@ -230,10 +319,23 @@ def fit_signatures(sessions: Iterable[Path], n_joints: int) -> Signatures:
             for c in np.flatnonzero(WEAR):
                 ok = np.isfinite(excess[:, c]) & np.isfinite(speed)
                 if ok.sum() >= 6:
-                    response[m, c, j] = np.linalg.lstsq(design[ok], excess[ok, c], rcond=None)[0]
-            response[m, SPEED, j] = 0.0
+                    response[m, c, j] = _growing_fit(design[ok], excess[ok, c], speed[ok])
+            response[m, ~WEAR, j] = 0.0
     use = np.tile(WEAR, (len(MECHANICAL_CLASSES), 1))
     return Signatures(baseline, spread, response, use)
+
+
+def _growing_fit(design: np.ndarray, excess: np.ndarray, speed: np.ndarray) -> np.ndarray:
+    """``[4]`` the response's least-squares terms, grown from no wear in the direction it ends:
+    a softer drive's lag grows as 1 / (1 - 0.85 s), steeply at the end, and a quadratic fitted
+    at 0.3, 0.6 and 0.9 bends below zero at low severity, so a day 0.1 worn could only be read
+    as 0.3. Where the linear term points against the response at 0.9 (at the episodes' mean
+    speed), the excess is fitted by the quadratic terms alone."""
+    terms = np.linalg.lstsq(design, excess, rcond=None)[0]
+    v = float(np.mean(speed))
+    if (terms[0] + terms[1] * v) * _response(terms, 0.9, v) < 0:
+        terms = np.r_[0.0, 0.0, np.linalg.lstsq(design[:, 2:], excess, rcond=None)[0]]
+    return terms
 
 
 def adapt(episodic: Signatures, days: Iterable[tuple[np.ndarray, np.ndarray, int]]) -> Signatures:
@@ -241,7 +343,8 @@ def adapt(episodic: Signatures, days: Iterable[tuple[np.ndarray, np.ndarray, int
     [J], mode)`` (``mode``: the index of the life's wearing mode, -1 for a healthy life). The
     healthy level and spread are re-fitted on the joints at severity 0; each (mode, channel)'s
     response is scaled by the least-squares ratio of the days' excess to the episodes'
-    prediction, pooled over joints, and read only where that ratio lies in :data:`TRUSTED`."""
+    prediction, pooled over joints, and read only where that ratio lies in :data:`TRUSTED`;
+    then how far the days stray from that response is measured (:func:`_relative_error`)."""
     days = list(days)
     healthy = [r[:, j] for r, truth, _ in days for j in np.flatnonzero(np.asarray(truth) == 0)]
     if len(healthy) < 6:
@@ -269,4 +372,30 @@ def adapt(episodic: Signatures, days: Iterable[tuple[np.ndarray, np.ndarray, int
     use = WEAR[None] & (ratio > TRUSTED[0]) & (ratio < TRUSTED[1])
     response = episodic.response * np.where(use, ratio, 0.0)[:, :, None, None]
     response[~np.isfinite(episodic.response)] = np.nan
-    return Signatures(baseline, spread, response, use, DETECT, MARGIN)
+    error = _relative_error(baseline, spread, response, days)  # 0 where a channel is unread
+    return Signatures(baseline, spread, response, use, DETECT, MARGIN, error)
+
+
+def _relative_error(
+    baseline: np.ndarray,
+    spread: np.ndarray,
+    response: np.ndarray,
+    days: list[tuple[np.ndarray, np.ndarray, int]],
+) -> np.ndarray:
+    """``[M, C]`` how far the wearing joints' days stray from the response, as a share of it:
+    the scatter beyond one healthy spread, pooled over days and joints. A channel that tracks the
+    severity day after day (backlash's lag: 0.14) keeps its weight at any severity; one whose
+    fit swings from day to day (the dead zone and compliance on a joint whose torque seldom
+    changes sign: 0.2-0.8) stops outvoting it once its predicted excess is large."""
+    num = np.zeros(response.shape[:2])
+    den = np.zeros_like(num)
+    for r, truth, mode in days:
+        s = np.asarray(truth, float)
+        for j in np.flatnonzero(s > 0) if mode >= 0 else ():
+            z = (r[:, j] - _level(baseline, r)[:, j]) / spread[:, j]
+            predicted = _response(response[mode, :, j], s[j], r[SPEED, j]) / spread[:, j]
+            ok = np.isfinite(z) & np.isfinite(predicted)
+            num[mode, ok] += np.maximum((z[ok] - predicted[ok]) ** 2 - 1.0, 0.0)
+            den[mode, ok] += predicted[ok] ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(den > 0, np.sqrt(num / den), 0.0)

@@ -44,8 +44,8 @@ class HealthTracker:
 
     state_dir: Path
     estimator: TrendRul = field(default_factory=TrendRul)
-    lead_days: float = 10.0
-    floor: float = 0.15
+    lead_days: float = 15.0  # conf/monitor.yaml health.lead_days
+    floor: float = 0.2
     monotone: bool = False  # read each joint's history as wear that never heals (index_model.py)
 
     def _path(self, arm: str) -> Path:
@@ -72,9 +72,11 @@ class HealthTracker:
         day: float,
         health: SessionHealth,
         joints: Sequence[str] = JOINT_NAMES,
+        channel: np.ndarray | None = None,
     ) -> list[JointHealth]:
         """Add one session's index (at operating ``day``) and return every joint's estimate
-        (``joints``: the arm's, the index's order)."""
+        (``joints``: the arm's, the index's order; ``channel [C, J]``: the session's channel
+        readings, kept for the next sessions' index: :meth:`recent_channels`)."""
         state = self.history(arm)
         if list(state.get("joints", JOINT_NAMES)) != list(joints) and state["sessions"]:
             raise InputError(f"{arm}: a history of joints {state.get('joints', JOINT_NAMES)}, "
@@ -83,17 +85,29 @@ class HealthTracker:
         last = state["sessions"][-1]["day"] if state["sessions"] else None
         if last is not None and day <= last:
             raise InputError(f"{arm}: session day {day} is not after the last one ({last})")
-        state["sessions"].append(
-            {
-                "day": float(day),
-                "index": np.round(health.index, 6).tolist(),
-                "low": np.round(health.low, 6).tolist(),
-                "high": np.round(health.high, 6).tolist(),
-                "windows": int(health.windows),
-            }
-        )
+        session = {
+            "day": float(day),
+            "index": np.round(health.index, 6).tolist(),
+            "low": np.round(health.low, 6).tolist(),
+            "high": np.round(health.high, 6).tolist(),
+            "windows": int(health.windows),
+        }
+        if channel is not None:  # JSON has no NaN: a channel not read is stored as null
+            rounded = np.round(np.asarray(channel, float), 8)
+            session["channel"] = np.where(np.isfinite(rounded), rounded, None).tolist()
+        state["sessions"].append(session)
         atomic_write_json(self._path(arm), state)
         return self.assess(state)
+
+    def recent_channels(self, arm: str, sessions: int) -> list[np.ndarray]:
+        """The channel readings ``[C, J]`` of the arm's last ``sessions`` sessions, oldest
+        first; fewer where a session in that stretch kept none (a gap breaks the run)."""
+        out: list[np.ndarray] = []
+        for session in reversed(self.history(arm)["sessions"][-sessions:] if sessions else []):
+            if session.get("channel") is None:
+                break
+            out.insert(0, np.asarray(session["channel"], float))  # null reads back as NaN
+        return out
 
     def assess(self, state: dict[str, Any]) -> list[JointHealth]:
         sessions = state["sessions"]

@@ -31,6 +31,7 @@ from robohealth_mj.prognostics.health import (
 )
 from robohealth_mj.prognostics.index_model import FittedIndex, session_reading
 from robohealth_mj.prognostics.rul import TrendRul
+from robohealth_mj.prognostics.signature import LOAD_DAYS
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.contact import ContactPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
@@ -299,18 +300,22 @@ class SessionWear:
         health = session_health(attribution_from_probabilities(p_class, p_joint))
         if health.windows == 0:
             raise InputError(f"{self.stream_id}: no decided window this session: no health index")
+        channel = None if self.channels is None else self.channels.readings()
         if self.index is not None:  # the calibrated reading and its band
             day = {"raw": health.raw, **session_reading(
                 mode_probabilities(p_class, p_joint), np.array(self.moved).reshape(p_joint.shape)
             )}  # fmt: skip
-            if self.channels is not None:
-                day["channel"] = self.channels.readings()
+            if channel is not None:  # with the last days' readings, oldest first
+                day["channel"] = channel
+                earlier = self.tracker.recent_channels(self.stream_id, LOAD_DAYS - 1)
+                if all(r.shape == channel.shape for r in earlier):
+                    day["recent_channel"] = [*earlier, channel]
             elif self.index.model.raw == "channel":
                 raise InputError(f"{self.stream_id}: the index reads the joints' channels, and "
                                  "this source gave none")  # fmt: skip
             health.index = self.index.calibrate(day)
             health.low, health.high = self.index.band(health.low, health.high, health.index)
-        joints = self.tracker.update(self.stream_id, self.day, health, self.names)
+        joints = self.tracker.update(self.stream_id, self.day, health, self.names, channel)
         fields = dict(health_fields(joints))
         for j in joints:
             name = j.joint

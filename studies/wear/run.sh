@@ -30,6 +30,8 @@ if part planner; then
   # the wearing joint's severity: the index against the channel each mode acts on
   $PY studies/wear/severity_channels.py outputs/lives/planner_s42 \
       > studies/wear/results/severity_channels.md
+  # a gap against a softer drive on a loaded joint: one day cannot tell them, the days' loads can
+  $PY studies/wear/load_dependence.py > studies/wear/results/load_dependence.md
   $PY -m robohealth_mj.report --lives outputs/lives/planner_s42/lives.json \
       --out outputs/lives/planner_s42/figures
   cp outputs/lives/planner_s42/figures/life_fresh_lives_00_seed6000.png \

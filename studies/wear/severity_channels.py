@@ -9,7 +9,8 @@ recorded channel each mechanical mode acts on, on the wearing joint while it tur
 a torque against the motion (``effort_residual`` x sign(``vel``)); a backlash gap lets the link
 lag its target (RMS ``pos_error``); and (c) the four modes' signatures
 (:mod:`robohealth_mj.prognostics.signature`): the severity they read with the life's mode named
-(monotone, as the monitor reads it), and how often they name that mode themselves on days worn
+(monotone, as the monitor reads it), and how often they name that mode themselves (with the
+last days' loads, as the monitor calls it) on days worn
 past 0.1. Per mode: the rank correlation of (a) and (b) with the severity over
 the life's days, and the linear correlation (how nearly a straight line), means over lives; for
 the index, the share of the severity range it spans
@@ -84,7 +85,7 @@ def main() -> None:
                              for d in life["days"]])  # fmt: skip
             read = np.nan_to_num(read)
             mono = np.array([monotone_index(read[: k + 1])[-1] for k in range(len(read))])
-            called = [fits.signatures.call(np.asarray(d["channel"]))[0][j] == m
+            called = [fits.signatures.call(np.asarray(d["channel"]), d["recent_channel"])[0][j] == m
                       for d, t in zip(life["days"], truth, strict=True) if t > 0.1]  # fmt: skip
             row |= {"signature_mae": float(np.abs(mono - truth).mean()),
                     "signature_called": float(np.mean(called)) if called else np.nan}  # fmt: skip

@@ -8,7 +8,12 @@ import numpy as np
 import pytest
 
 from robohealth_mj.common.errors import InputError
-from robohealth_mj.prognostics.channels import ChannelSums, channel_readings, fit_scales
+from robohealth_mj.prognostics.channels import (
+    CHANNELS,
+    ChannelSums,
+    channel_readings,
+    fit_scales,
+)
 from robohealth_mj.prognostics.index_model import ChannelFits, FittedIndex, IndexModel, fit_index
 from robohealth_mj.schema import FAULT_CLASSES, FEATURE_NAMES
 
@@ -36,6 +41,22 @@ def test_a_friction_torque_and_a_gap_read_as_themselves_on_the_turning_joint():
         sums.add(tick)
     batch = channel_readings(_ticks(200, 1.5, 0.004), J)
     assert sums.readings() == pytest.approx(batch, nan_ok=True)
+
+
+def test_a_few_torque_impulses_lift_the_peak_channel_where_the_spread_barely_moves():
+    """A catching gear at low severity: six knocks in a minute of ticks."""
+    rng = np.random.default_rng(3)
+    healthy = _ticks(1200)
+    healthy[:, :J, FEATURE_NAMES.index("effort_residual")] = rng.normal(0.0, 0.2, (1200, J))
+    knocked = healthy.copy()
+    knocked[rng.choice(1200, 6, replace=False), 0, FEATURE_NAMES.index("effort_residual")] += 1.5
+    before, after = channel_readings(healthy, J), channel_readings(knocked, J)
+    with np.errstate(invalid="ignore"):  # channels this sample does not carry read NaN
+        rise = after[:, 0] / before[:, 0] - 1.0
+    assert (
+        rise[CHANNELS.index("residual_rms")] < 0.2 and rise[CHANNELS.index("residual_peak")] > 1.0
+    )
+    assert after[:, 1] == pytest.approx(before[:, 1], nan_ok=True)  # the other joint: untouched
 
 
 def test_the_scales_are_the_reading_per_unit_severity_of_labelled_episodes(tmp_path):

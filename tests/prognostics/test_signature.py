@@ -15,7 +15,7 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.prognostics.channels import CHANNELS, channel_readings
 from robohealth_mj.prognostics.health import MECHANICAL_CLASSES
 from robohealth_mj.prognostics.index_model import ChannelFits, FittedIndex, IndexModel, fit_index
-from robohealth_mj.prognostics.signature import Signatures, adapt, fit_signatures
+from robohealth_mj.prognostics.signature import Signatures, _growing_fit, adapt, fit_signatures
 from robohealth_mj.schema import FAULT_CLASSES, FEATURE_NAMES
 
 J = 2
@@ -86,13 +86,19 @@ def _day(rng, mode: str | None, joint: int, s: float, speed: float):
 
 
 @pytest.fixture(scope="module")
-def signatures(tmp_path_factory) -> Signatures:
+def world(tmp_path_factory) -> tuple[Signatures, list]:
+    """Signatures fitted on a labelled recording's episodes, and whole days to adapt them to."""
     rng = np.random.default_rng(7)
     path = tmp_path_factory.mktemp("signature") / "graphs.jsonl.cache.npz"
     _recording(path, rng)
     days = [_day(rng, mode, j, s, speed) for mode in (*MECHANICAL_CLASSES, None)
             for j in range(J) for s in (0.2, 0.5, 0.8) for speed in (0.4, 0.9)]  # fmt: skip
-    return adapt(fit_signatures([path], J), days)
+    return fit_signatures([path], J), days
+
+
+@pytest.fixture(scope="module")
+def signatures(world) -> Signatures:
+    return adapt(*world)
 
 
 @pytest.mark.parametrize("mode", MECHANICAL_CLASSES)
@@ -122,8 +128,12 @@ def test_a_healthy_joint_reads_no_wear_at_any_speed_though_its_readings_rise_wit
     short = [channel_readings(_ticks(150, rng, v), J) for v in rng.uniform(0.3, 1.0, 10)]
     for r in (slow, fast, *short):
         assert (signatures.call(r)[1] == 0.0).all()
-    no_detect = dataclasses.replace(signatures, detect=0.0)  # noise alone then reads as wear
-    assert max(no_detect.call(r)[1].max() for r in short) > 0.0
+    by_hand = _by_hand(margin=20.0)  # a jam moves the vibration 10 spreads per unit severity
+    noise = np.zeros((len(CHANNELS), 1))
+    noise[CHANNELS.index("vibration")] = 3.0  # three spreads of healthy noise on that channel
+    assert by_hand.call(noise)[1][0] == 0.0
+    no_detect = dataclasses.replace(by_hand, detect=0.0)  # noise alone then reads as wear
+    assert no_detect.call(noise)[1][0] == pytest.approx(0.3)
 
 
 def _by_hand(margin: float, joints: int = 1) -> Signatures:
@@ -143,8 +153,8 @@ def _by_hand(margin: float, joints: int = 1) -> Signatures:
     return Signatures(np.zeros((c, joints, 3)), np.ones((c, joints)), response, use, 16.0, margin)
 
 
-def test_a_call_is_sure_only_where_no_other_mode_explains_the_readings_nearly_as_well():
-    signatures = _by_hand(margin=0.7)
+def test_a_call_is_sure_only_where_no_other_mode_fits_the_readings_nearly_as_well():
+    signatures = _by_hand(margin=20.0)
     friction_day, lag_day = np.zeros((len(CHANNELS), 1)), np.zeros((len(CHANNELS), 1))
     friction_day[CHANNELS.index("friction")] = 40.0
     lag_day[CHANNELS.index("lag")] = 40.0
@@ -161,9 +171,9 @@ def test_a_mode_that_barely_moves_the_channels_is_not_read_from_them():
     0.5, but one spread of noise would move that by 0.1, so the call is not sure."""
     day = np.zeros((len(CHANNELS), 1))
     day[CHANNELS.index("vibration")] = 5.0
-    mode, severity, sure = _by_hand(margin=0.7).call(day)
+    mode, severity, sure = _by_hand(margin=20.0).call(day)
     assert MECHANICAL_CLASSES[mode[0]] == "jam" and severity[0] == 0.5 and not sure[0]
-    size = _by_hand(margin=0.7).size(0.5, np.array([0.3]))[:, 0]
+    size = _by_hand(margin=20.0).size(0.5, np.array([0.3]))[:, 0]
     assert size[MECHANICAL_CLASSES.index("jam")] == pytest.approx(5.0)
     assert size[MECHANICAL_CLASSES.index("friction")] == pytest.approx(50.0)
 
@@ -173,7 +183,7 @@ def test_a_mode_felt_on_two_joints_is_called_sure_only_where_it_shows_most():
     call, the neighbour falls back to the window model's reading."""
     day = np.zeros((len(CHANNELS), 2))
     day[CHANNELS.index("friction")] = (40.0, 15.0)
-    mode, severity, sure = _by_hand(margin=0.7, joints=2).call(day)
+    mode, severity, sure = _by_hand(margin=20.0, joints=2).call(day)
     assert (mode == MECHANICAL_CLASSES.index("friction")).all()
     assert severity.tolist() == [0.4, 0.15] and sure.tolist() == [True, False]
 
@@ -200,7 +210,7 @@ def test_a_signature_index_takes_the_sure_calls_and_is_saved_as_the_monitor_read
         return {"truth": [severity], "raw": [0.5], "raw_moving": [0.5],
                 "raw_modes": modes.tolist(), "channel": readings.tolist()}  # fmt: skip
 
-    fits = ChannelFits(scales, _by_hand(margin=0.7))
+    fits = ChannelFits(scales, _by_hand(margin=20.0))
     fitted = fit_index(IndexModel("signature", "none"), [day(0.2, "friction")], fits)
     assert fitted.calibrate(day(0.4, "friction"))[0] == pytest.approx(0.4)  # sure: friction
     assert fitted.calibrate(day(0.4, "lag"))[0] == pytest.approx(0.2)  # not sure: 40 / 200
@@ -209,7 +219,7 @@ def test_a_signature_index_takes_the_sure_calls_and_is_saved_as_the_monitor_read
     loaded = FittedIndex.load(path)
     for probe in (day(0.4, "friction"), day(0.4, "lag"), day(0.05, "friction")):
         assert loaded.calibrate(probe) == pytest.approx(fitted.calibrate(probe))
-    assert loaded.channels.signatures.detect == 16.0 and loaded.channels.signatures.margin == 0.7
+    assert loaded.channels.signatures.detect == 16.0 and loaded.channels.signatures.margin == 20.0
     with pytest.raises(InputError, match="needs the channels' signatures"):
         fit_index(IndexModel("signature_named", "pooled"), [day(0.2, "lag")])
     path.write_text(json.dumps({**fitted.to_json(), "channel_scales": None}))
@@ -223,3 +233,117 @@ def test_a_signature_index_takes_the_sure_calls_and_is_saved_as_the_monitor_read
     path.write_text(json.dumps(broken))
     with pytest.raises(InputError, match=r"index.json: signatures: a signature of channels"):
         FittedIndex.load(path)
+
+
+def test_a_channel_that_strays_from_day_to_day_stops_outvoting_one_that_tracks_the_wear():
+    """Backlash moves the lag and the dead zone 100 spreads per unit severity, but the dead
+    zone's day-to-day fit swings (error 1.0) where the lag tracks (0.05): a day at 0.5 whose
+    dead zone read nothing is read from its lag, not split between the two."""
+    c = len(CHANNELS)
+    error = np.zeros((len(MECHANICAL_CLASSES), c))
+    backlash = MECHANICAL_CLASSES.index("backlash")
+    lag, gap = CHANNELS.index("lag"), CHANNELS.index("gap")
+    error[backlash, lag], error[backlash, gap] = 0.05, 1.0
+    exact = _by_hand(margin=20.0)
+    response = exact.response.copy()
+    response[backlash, gap, :, 0] = 100.0
+    exact = dataclasses.replace(exact, response=response)
+    scattered = dataclasses.replace(exact, error=error)
+    day = np.zeros((c, 1))
+    day[lag] = 50.0
+    mode = np.array([backlash])
+    assert exact.read(day, mode)[0] == pytest.approx(0.25, abs=0.01)
+    assert scattered.read(day, mode)[0] == pytest.approx(0.5, abs=0.02)
+    again = Signatures.from_json(json.loads(json.dumps(scattered.to_json())), "signatures.json")
+    assert again.read(day, mode) == scattered.read(day, mode)
+
+
+def test_the_days_set_how_far_each_channel_strays(world):
+    """A lag that swings by a random factor from day to day is given a larger share of error
+    than the same lag read faithfully; a channel a mode never reads is given none."""
+    episodic, days = world
+    rng = np.random.default_rng(13)
+    lag, backlash = CHANNELS.index("lag"), MECHANICAL_CLASSES.index("backlash")
+    swung = []
+    for r, truth, mode in days:
+        r = r.copy()
+        if mode == backlash:
+            r[lag] *= rng.uniform(0.4, 1.6)
+        swung.append((r, truth, mode))
+    faithful, swinging = adapt(episodic, days).error, adapt(episodic, swung).error
+    assert faithful[backlash, lag] < 0.1 and swinging[backlash, lag] > 0.2
+    assert (faithful[~adapt(episodic, days).use] == 0).all()
+
+
+def _loaded_days(spring: bool, loads=(30.0, 24.0, 36.0, 30.0, 24.0)) -> np.ndarray:
+    """``[K, C, 1]`` days of a joint that carries the arm's weight, its lag growing by 2 spreads
+    a day: a gap's whatever the load, a spring's in proportion to it (at load 30 the same)."""
+    days = np.zeros((len(loads), len(CHANNELS), 1))
+    for k, load in enumerate(loads):
+        lag = 50.0 + 2.0 * k
+        days[k, CHANNELS.index("lag")] = lag * load / 30.0 if spring else lag
+        days[k, CHANNELS.index("load")] = load
+    return days
+
+
+def test_the_days_loads_tell_a_gap_from_a_softer_spring_where_a_day_cannot():
+    """Within a day both sag by one offset; a gap's lag holds as the payload changes from day
+    to day, a spring's follows it. Too few days, or a load that never changed: no verdict."""
+    signatures = _by_hand(margin=20.0)
+    backlash, spring = (MECHANICAL_CLASSES.index(m) for m in ("backlash", "struct_weaken"))
+    assert signatures.settle(_loaded_days(spring=False)).tolist() == [backlash]
+    assert signatures.settle(_loaded_days(spring=True)).tolist() == [spring]
+    steady = (30.0, 30.3, 29.7, 30.0, 30.2)  # a load that barely changed: no verdict
+    assert signatures.settle(_loaded_days(False, steady)).tolist() == [-1]
+    assert signatures.settle(_loaded_days(True)[:-1]).tolist() == [-1]
+
+
+def test_a_call_between_a_gap_and_a_spring_is_settled_by_the_last_days_loads():
+    signatures = _by_hand(margin=20.0)
+    days = _loaded_days(spring=True)
+    mode, _, sure = signatures.call(days[-1])
+    assert MECHANICAL_CLASSES[mode[0]] == "backlash" and not sure[0]  # a day alone: a tie
+    mode, severity, sure = signatures.call(days[-1], days)
+    assert MECHANICAL_CLASSES[mode[0]] == "struct_weaken" and sure[0]
+    assert severity[0] == signatures.read(days[-1], mode)[0]
+    friction_day = np.zeros((len(CHANNELS), 1))
+    friction_day[CHANNELS.index("friction")] = 40.0
+    assert MECHANICAL_CLASSES[signatures.call(friction_day, days)[0][0]] == "friction"
+
+
+def test_a_response_steep_at_the_end_still_reads_light_wear_as_light():
+    """A softer drive's lag grows as s / (1 - 0.85 s): fitted at 0.3, 0.6 and 0.9 a plain
+    quadratic bends below zero at light wear, and a day worn 0.1 could only read 0.3."""
+    sev = np.repeat([0.3, 0.6, 0.9], 4)
+    speed = np.tile([0.3, 0.5, 0.7, 0.9], 3)
+    design = np.stack([sev, sev * speed, sev**2, sev**2 * speed], axis=1)
+    excess = 100.0 * sev / (1.0 - 0.85 * sev)
+    plain = np.linalg.lstsq(design, excess, rcond=None)[0]
+    signatures = _by_hand(margin=20.0)
+    spring, lag = MECHANICAL_CLASSES.index("struct_weaken"), CHANNELS.index("lag")
+    day = np.zeros((len(CHANNELS), 1))
+    day[lag] = 100.0 * 0.1 / (1.0 - 0.085)
+    day[CHANNELS.index("speed")] = 0.6
+    reads = []
+    for terms in (plain, _growing_fit(design, excess, speed)):
+        response = signatures.response.copy()
+        response[spring] = 0.0
+        response[spring, lag, 0] = terms
+        reads.append(dataclasses.replace(signatures, response=response).read(day, [spring])[0])
+    assert reads[0] >= 0.2 and reads[1] == pytest.approx(0.1, abs=0.06)
+
+
+def test_a_mode_cannot_buy_a_loose_fit_by_predicting_a_large_uncertain_excess():
+    """A softer drive that also moves the residual's spread, with five times its own size of
+    scatter there: predicting 40 spreads it cannot vouch for must cost it, or any stray excess
+    on that channel (3 spreads here) would read as its evidence rather than as noise."""
+    signatures = _by_hand(margin=20.0)
+    spring, rms = MECHANICAL_CLASSES.index("struct_weaken"), CHANNELS.index("residual_rms")
+    response = signatures.response.copy()
+    response[spring, rms, :, 0] = 100.0
+    error = np.zeros(signatures.use.shape)
+    error[spring, rms] = 5.0
+    day = np.zeros((len(CHANNELS), 1))
+    day[CHANNELS.index("lag")], day[rms] = 40.0, 3.0
+    loose = dataclasses.replace(signatures, response=response, error=error)
+    assert MECHANICAL_CLASSES[loose.call(day)[0][0]] == "backlash"

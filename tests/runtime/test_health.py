@@ -3,14 +3,21 @@
 from __future__ import annotations
 
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from omegaconf import OmegaConf
 
 from robohealth_mj.common.errors import InputError
+from robohealth_mj.prognostics.channels import CHANNELS
 from robohealth_mj.prognostics.health import SessionHealth
+from robohealth_mj.prognostics.index_model import IndexModel
 from robohealth_mj.prognostics.rul import TrendRul
+from robohealth_mj.prognostics.signature import LOAD_DAYS
 from robohealth_mj.runtime.health import HealthTracker, health_fields
+from robohealth_mj.runtime.monitor import SessionWear
+from robohealth_mj.schema import FEATURE_NAMES, JOINT_NAMES
 
 
 def _session(elbow: float) -> SessionHealth:
@@ -71,3 +78,56 @@ def test_a_monotone_reading_keeps_a_worn_joint_worn_through_a_light_day(tmp_path
     assert low[2].index == pytest.approx(0.1) and kept[2].index == pytest.approx(0.8 / 3)
     assert kept[2].rul.slope > 0 and kept[2].rul.slope > low[2].rul.slope
     assert [s["index"][2] for s in worn.history("arm")["sessions"]] == readings
+
+
+def test_the_history_keeps_each_sessions_channel_readings_for_the_next_sessions(tmp_path):
+    """A joint that never turned reads NaN: kept as null, read back as NaN. A session that kept
+    no readings breaks the run of recent days."""
+    tracker = HealthTracker(tmp_path)
+    readings = [np.full((3, 6), float(day)) for day in range(4)]
+    readings[3][1, 4] = np.nan
+    for day, channel in enumerate(readings):
+        tracker.update("a", day, _session(0.1), channel=None if day == 1 else channel)
+    recent = tracker.recent_channels("a", 3)
+    assert len(recent) == 2  # day 1 kept none: days 2 and 3
+    assert recent[0] == pytest.approx(readings[2]) and np.isnan(recent[1][1, 4])
+    assert recent[1] == pytest.approx(readings[3], nan_ok=True)
+    assert tracker.recent_channels("a", 0) == [] and tracker.recent_channels("b", 3) == []
+
+
+def test_the_monitor_hands_the_index_the_last_days_channel_readings(tmp_path):
+    """Each session's index reads that day's channels with the days before it (as many as the
+    load test weighs, oldest first): here the elbow's load rises by 1 N m a day."""
+    seen = []
+
+    class Recorder:  # an index that keeps what the monitor handed it
+        model = IndexModel("signature", "none")
+
+        def calibrate(self, day: dict) -> np.ndarray:
+            seen.append(day)
+            return np.zeros(len(JOINT_NAMES))
+
+        def band(self, low, high, index):
+            return low, high
+
+    cfg = OmegaConf.create({"state_dir": str(tmp_path), "day": 0, "calibration": None,
+                            "threshold": 0.8, "lead_days": 10.0, "floor": 0.15})  # fmt: skip
+    elbow, load = JOINT_NAMES.index("elbow"), CHANNELS.index("load")
+    healthy = SimpleNamespace(
+        valid=True, fault_class="none", class_probabilities={"none": 1.0},
+        joint_scores=dict.fromkeys(JOINT_NAMES, 0.0),
+    )  # fmt: skip
+    for day in range(LOAD_DAYS + 1):
+        cfg.day = day
+        wear = SessionWear("arm1", cfg)
+        wear.index = Recorder()
+        x = np.zeros((2 * len(JOINT_NAMES), len(FEATURE_NAMES)))
+        x[elbow, FEATURE_NAMES.index("vel")] = 0.5
+        x[elbow, FEATURE_NAMES.index("effort")] = 10.0 + day
+        for _ in range(40):
+            wear.add(healthy, list(JOINT_NAMES), np.abs(x[: len(JOINT_NAMES), 0]), x)
+        wear.finish()
+    assert len(seen[0]["recent_channel"]) == 1
+    recent = seen[-1]["recent_channel"]
+    assert len(recent) == LOAD_DAYS and recent[-1] is seen[-1]["channel"]
+    assert [r[load, elbow] for r in recent] == pytest.approx([11.0, 12.0, 13.0, 14.0, 15.0])
