@@ -379,7 +379,7 @@ def choose(rows: list[dict]) -> dict:
     lives as the best to within one life, the fewest healthy warnings, then the lowest
     wearing-joint MAE. One life is a step of 6 points among 16, inside the share's own noise (a
     binomial standard error of 9 points at 0.85), while the MAE over 390 joint-days separates
-    index models far more finely: ranked on the share first, a one-life lead chose an index 0.03
+    index models far more finely: ranked on the share first, a one-life lead chose an index 0.04
     worse on the MAE (the issue-68 third pass, studies/wear/README.md)."""
     valid = [r["groups"]["validation"] for r in rows]
     step = 1.0 / max(valid[0]["warnings"]["lives"], 1)
