@@ -205,7 +205,8 @@ class Signatures:
         j = np.arange(cost.shape[-1])
         best = cost[mode, :, j]  # [J, S]
         severity = SEVERITY_GRID[best.argmin(axis=1)]
-        severity[at_zero[mode, j] - best.min(axis=1) < self.detect] = 0.0
+        with np.errstate(invalid="ignore"):  # a (mode, joint) never fitted: inf - inf, NaN below
+            severity[at_zero[mode, j] - best.min(axis=1) < self.detect] = 0.0
         return np.where(seen & np.isfinite(best).any(axis=1), severity, np.nan)
 
     def size(self, severity: float, speed: np.ndarray) -> np.ndarray:

@@ -30,10 +30,13 @@ def _ticks(
     joint: int = 0,
     s: float = 0.0,
     episode: bool = False,
+    steep: bool = False,
 ):
     """Snapshots ``[n, 2J, F]`` of two joints turning back and forth at ``speed``; the healthy
     tracking error and torque residual grow with the speed. In a short labelled ``episode`` a
-    backlash also rings the sensor's high band (an onset transient whole days do not show)."""
+    backlash also rings the sensor's high band (an onset transient whole days do not show). A
+    ``steep`` softer drive loses stiffness as the built one does (x (1 - 0.85 s)): its lag grows
+    as s / (1 - 0.85 s)."""
     x = np.zeros((n, 2 * J, len(FEATURE_NAMES)), np.float32)
     t = np.arange(n)
     vel = speed * np.sign(np.sin(t / 5.0) + 1e-9)
@@ -48,7 +51,7 @@ def _ticks(
             pos_error += 4e-3 * s * np.sign(effort)
             x[:, J + j, F["vib_200_450"]] += 0.01 * s * episode
         if j == joint and mode == "struct_weaken":
-            pos_error += 4e-4 * s * effort
+            pos_error += 4e-4 * (s / (1.0 - 0.85 * s) if steep else s) * effort
         if j == joint and mode == "jam":
             hits = rng.random(n) < 0.2 * s
             residual += hits * 8.0 * s * rng.choice([-1.0, 1.0], n)  # impulses either way
@@ -347,3 +350,28 @@ def test_a_mode_cannot_buy_a_loose_fit_by_predicting_a_large_uncertain_excess():
     day[CHANNELS.index("lag")], day[rms] = 40.0, 3.0
     loose = dataclasses.replace(signatures, response=response, error=error)
     assert MECHANICAL_CLASSES[loose.call(day)[0][0]] == "backlash"
+
+
+def test_a_steep_softer_drive_fitted_at_three_severities_reads_light_wear_lightly(tmp_path):
+    """Fitted on episodes at 0.3, 0.6 and 0.9 only, a softer drive whose lag steepens toward
+    full wear must still grow from no wear: a day worn 0.12 reads near 0.12, not 0.3."""
+    rng = np.random.default_rng(23)
+    parts, labels = [], []
+    for speed in (0.3, 0.6, 1.0):
+        for s in (0.3, 0.6, 0.9):
+            parts.append(_ticks(300, rng, speed, "struct_weaken", 0, s, steep=True))
+            labels.append((FAULT_CLASSES.index("struct_weaken"), 0, s))
+            for mode in ("backlash", "friction", "jam"):  # every mode fitted, as the corpus has
+                parts.append(_ticks(300, rng, speed, mode, 0, s))
+                labels.append((FAULT_CLASSES.index(mode), 0, s))
+            parts.append(_ticks(300, rng, speed * rng.uniform(0.8, 1.2)))
+            labels.append((0, -1, 0.0))
+    label = [np.concatenate([np.full(len(p), lab[k]) for p, lab in zip(parts, labels, strict=True)])
+             for k in range(3)]  # fmt: skip
+    path = tmp_path / "graphs.jsonl.cache.npz"
+    np.savez(path, x=np.concatenate(parts), fault_class=label[0], fault_joint=label[1],
+             severity=label[2])  # fmt: skip
+    fitted = dataclasses.replace(fit_signatures([path], J), detect=16.0)
+    spring = MECHANICAL_CLASSES.index("struct_weaken")
+    day = channel_readings(_ticks(1500, rng, 0.6, "struct_weaken", 0, 0.12, steep=True), J)
+    assert fitted.read(day, np.full(J, spring))[0] == pytest.approx(0.12, abs=0.05)
