@@ -98,18 +98,25 @@ class Signatures:
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(WEAR[:, None], (r - _level(self.baseline, r)) / self.spread, np.nan)
 
-    def _costs(self, readings: np.ndarray) -> tuple[np.ndarray, ...]:
-        """``(cost [M, S, J], at_zero [M, J], seen [J], size [M, S, J])``: per mode and grid
-        severity the squared misfit over the mode's channels (each in units of its expected
-        scatter: one healthy spread, and :attr:`error` of the predicted excess), the misfit of
-        no wear, whether any channel was read, and the predicted excess's size over the channels
-        read, in healthy spreads (how far a healthy day's noise can move the read)."""
-        z = self.excess(readings)  # [C, J]
+    def _grid(self, readings: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(excess [C, J], predicted [M, S, C, J], scatter [M, S, C, J])``: the day's excess
+        and, per mode and grid severity, the excess the mode predicts on the channels it is read
+        from (in spreads) and its expected squared scatter (one healthy spread, and
+        :attr:`error` of the predicted excess)."""
+        z = self.excess(readings)
         v = np.asarray(readings, float)[SPEED]
         predicted = _response(self.response[:, None], SEVERITY_GRID[:, None, None], v)
-        predicted = np.nan_to_num(predicted / self.spread)  # [M, S, C, J]
+        predicted = np.nan_to_num(predicted / self.spread) * self.use[:, None, :, None]
         error = np.zeros(self.use.shape) if self.error is None else self.error
-        scatter = 1.0 + (error[:, None, :, None] * predicted) ** 2  # [M, S, C, J], squared
+        return z, predicted, 1.0 + (error[:, None, :, None] * predicted) ** 2
+
+    def _costs(self, grid: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
+        """``(cost [M, S, J], at_zero [M, J], seen [J], size [M, S, J])`` of a day's
+        :meth:`_grid`: per mode and grid severity the squared misfit over the mode's channels,
+        each in units of its expected scatter, the misfit of no wear, whether any channel was
+        read, and the predicted excess's size over the channels read, in healthy spreads (how far
+        a healthy day's noise can move the read)."""
+        z, predicted, scatter = grid
         read = np.isfinite(z)[None] & self.use[:, :, None]  # [M, C, J]
         miss = np.where(read[:, None], np.nan_to_num(z) - predicted, 0.0) ** 2 / scatter
         cost = miss.sum(axis=2)
@@ -121,7 +128,7 @@ class Signatures:
     def read(self, readings: np.ndarray, mode: np.ndarray) -> np.ndarray:
         """``[J]`` the severity of ``mode [J]`` on each joint: 0 where it explains less than
         :attr:`detect` of the excess (in squared spreads), NaN where nothing was read."""
-        cost, at_zero, seen, _ = self._costs(readings)
+        cost, at_zero, seen, _ = self._costs(self._grid(readings))
         return self._severity(cost, at_zero, seen, np.asarray(mode, int))
 
     def call(
@@ -139,9 +146,10 @@ class Signatures:
         that shows them most is their source). ``recent [K, C, J]``: the last days' readings,
         this one last: where backlash and a softer drive fit best, their loads settle the call
         between them (:meth:`settle`) and the lead is taken over the other two modes."""
-        cost, at_zero, seen, size = self._costs(readings)
+        grid = self._grid(readings)
+        cost, at_zero, seen, size = self._costs(grid)
         step = cost.argmin(axis=1)  # [M, J]: each mode's severity read, on the grid
-        fit = np.where(np.isfinite(cost.min(axis=1)), self._misfit(readings, step), np.inf)
+        fit = np.where(np.isfinite(cost.min(axis=1)), self._misfit(grid, step), np.inf)
         mode = fit.argmin(axis=0)
         j = np.arange(len(mode))
         runner_up = np.sort(fit, axis=0)[1]
@@ -163,16 +171,14 @@ class Signatures:
             sure &= ~same | (best >= best[same].max())
         return mode, self._severity(cost, at_zero, seen, mode), sure
 
-    def _misfit(self, readings: np.ndarray, step: np.ndarray) -> np.ndarray:
-        """``[M, J]`` each mode's misfit at its severity ``SEVERITY_GRID[step [M, J]]`` over every
-        channel any mode reads: squared misfit per expected scatter plus the scatter's log."""
-        z = self.excess(readings)  # [C, J]
-        v = np.asarray(readings, float)[SPEED]
-        severity = SEVERITY_GRID[step][:, None, :]  # [M, 1, J]
-        predicted = np.nan_to_num(_response(self.response, severity, v) / self.spread)
-        predicted *= self.use[:, :, None]  # [M, C, J]
-        error = np.zeros(self.use.shape) if self.error is None else self.error
-        scatter = 1.0 + (error[:, :, None] * predicted) ** 2
+    def _misfit(self, grid: tuple[np.ndarray, ...], step: np.ndarray) -> np.ndarray:
+        """``[M, J]`` each mode's misfit at its severity ``SEVERITY_GRID[step [M, J]]`` (of a
+        day's :meth:`_grid`) over every channel any mode reads: squared misfit per expected
+        scatter plus the scatter's log."""
+        z, predicted, scatter = grid
+        at = step[:, None, None, :]  # [M, 1, 1, J]: each mode's own severity
+        predicted = np.take_along_axis(predicted, at, axis=1)[:, 0]  # [M, C, J]
+        scatter = np.take_along_axis(scatter, at, axis=1)[:, 0]
         miss = (np.nan_to_num(z)[None] - predicted) ** 2 / scatter + np.log(scatter)
         read = np.isfinite(z)[None] & self.use.any(axis=0)[None, :, None]
         return np.where(read, miss, 0.0).sum(axis=1)
@@ -192,7 +198,7 @@ class Signatures:
         if not ok.any():
             return out
         lag, load = lag[:, ok], load[:, ok]
-        gap, spring = _roughness(lag), _roughness(lag / load)
+        gap, spring = roughness(lag), roughness(lag / load)
         clear = (np.ptp(load, axis=0) >= LOAD_CHANGE * load.mean(axis=0)) & (
             np.minimum(gap, spring) <= LOAD_CLEAR * np.maximum(gap, spring)
         )
@@ -279,9 +285,9 @@ def _response(response: np.ndarray, severity, speed) -> np.ndarray:
     return severity * (r[0] + r[1] * speed) + severity**2 * (r[2] + r[3] * speed)
 
 
-def _roughness(paths: np.ndarray) -> np.ndarray:
+def roughness(paths: np.ndarray) -> np.ndarray:
     """``[J]`` how far each column of ``paths [K, J]`` (one value a day) strays from a straight
-    line through the days, relative to its mean."""
+    line through the days, relative to its mean: the load test's measure of a severity path."""
     y = paths / paths.mean(axis=0)
     t = np.arange(len(y))
     slope, intercept = np.polyfit(t, y, 1)

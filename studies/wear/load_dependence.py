@@ -26,6 +26,7 @@ import numpy as np
 
 from robohealth_mj.data.arrays import CACHE_SUFFIX
 from robohealth_mj.data.observability import MOVING_RAD_S
+from robohealth_mj.prognostics.signature import roughness
 from robohealth_mj.reporting.markdown import heading
 from robohealth_mj.schema import FEATURE_NAMES, JOINT_NAMES
 
@@ -47,13 +48,6 @@ def turning(corpus: Path, life: str, day: int, joint: int) -> dict[str, np.ndarr
         "effort": effort,
         "truth": float(z["severity"].max()),
     }
-
-
-def roughness(path: np.ndarray) -> float:
-    """How far a short severity path strays from a straight line, relative to its mean."""
-    y = path / np.mean(path)
-    t = np.arange(len(y))
-    return float(np.std(y - np.polyval(np.polyfit(t, y, 1), t)))
 
 
 def within_day(corpus: Path, life: str, day: int, joint: int) -> list[str]:
@@ -93,7 +87,9 @@ def votes(corpus: Path, lives: dict) -> list[str]:
             if truth[end - 1] < WORN:
                 continue
             span = slice(end - WINDOW, end)
-            if roughness(offset[span]) < roughness(offset[span] / load[span]):
+            paths = np.stack([offset[span], offset[span] / load[span]], axis=1)  # [K, 2]
+            gap_path, spring_path = roughness(paths)  # as the monitor's load test weighs them
+            if gap_path < spring_path:
                 gap += 1
             else:
                 spring += 1
