@@ -60,6 +60,21 @@ def _rotation(q: np.ndarray) -> np.ndarray:
     return out.reshape(3, 3)
 
 
+def mount_quat(axis: np.ndarray) -> np.ndarray | None:
+    """The quaternion (w x y z) of the frame a joint's sensor package is mounted in: its z the
+    joint's axis, turned from the link frame by the shortest arc (``None``: the link frame's z
+    already is the axis, as in every maker's description but KUKA's, whose pitch joints turn
+    about y). So every arm's accelerometer reads along its joint axis on z, and a model trained
+    on some makers reads another's sensors in the same frame (``studies/arms``)."""
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    if np.allclose(a, [0.0, 0.0, 1.0]):
+        return None
+    if np.allclose(a, [0.0, 0.0, -1.0]):
+        return np.array([0.0, 1.0, 0.0, 0.0])  # half a turn about x
+    q = np.array([1.0 + a[2], -a[1], a[0], 0.0])  # 1 + z.a, z x a
+    return q / np.linalg.norm(q)
+
+
 @dataclass(frozen=True)
 class DriveModel:
     """Our drive model, stated for the UR5e and scaled to any arm by one rule: each parameter
@@ -150,8 +165,10 @@ def build_arm_scene(
         body.add("joint", name=f"{joint}_deflection", type="hinge", axis=link.axis,
                  armature=0, damping=0, frictionloss=0)  # fmt: skip
         radius = (0.06 if big[j] else 0.045) * size
+        mount = mount_quat(link.axis)  # the housing and the sensor package around the axis
+        turn = np.eye(3) if mount is None else _rotation(mount)
         body.add("geom", name=f"{joint}_housing", type="cylinder", size=[radius, 1.1 * radius],
-                 material="urblue", contype=0, conaffinity=1)  # fmt: skip
+                 quat=mount, material="urblue", contype=0, conaffinity=1)  # fmt: skip
         if j + 1 < len(arm.links):  # the link's tube to the next joint
             nxt = arm.links[j + 1].origin_xyz
             if np.linalg.norm(nxt[:2]) > 2 * radius:
@@ -159,8 +176,9 @@ def build_arm_scene(
                 body.add("geom", name=f"{body_name}_tube", type="capsule", size=[0.8 * radius],
                          fromto=[0, 0, z, nxt[0], nxt[1], z], material="linkgray",
                          contype=0, conaffinity=1)  # fmt: skip
-        body.add("site", name=f"{joint}_sensor", pos=_sensor_position(link.com, radius, 0.1 * size),
-                 size=[0.008 * size], rgba=[1, 0.5, 0, 1], group=4)  # fmt: skip
+        place = turn @ _sensor_position(turn.T @ link.com, radius, 0.1 * size)
+        body.add("site", name=f"{joint}_sensor", pos=place, quat=mount, size=[0.008 * size],
+                 rgba=[1, 0.5, 0, 1], group=4)  # fmt: skip
         root.tendon.add(
             "fixed", name=f"{joint}_drive", stiffness=d["stiffness"], damping=d["tendon_damping"],
             springlength=[-d["backlash"], d["backlash"]],
@@ -189,7 +207,8 @@ def build_arm_scene(
 def _sensor_position(com: np.ndarray, radius: float, along: float) -> np.ndarray:
     """The sensor package sits on its link next to the joint, on the side of the link's centre of
     mass (so on the link, not in the air), at the centre of mass's height: on the housing, or
-    ``along`` out on a long link (the upper arm and forearm, as on the first UR5e)."""
+    ``along`` out on a long link (the upper arm and forearm, as on the first UR5e). ``com`` in
+    the mount frame (z the joint axis), and so the result."""
     radial = np.array([com[0], com[1]], dtype=float)
     norm = float(np.linalg.norm(radial))
     direction = radial / norm if norm > 1e-6 else np.array([1.0, 0.0])

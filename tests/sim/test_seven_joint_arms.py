@@ -35,6 +35,31 @@ def test_the_builder_gives_every_joint_its_drive_sensor_and_servo(name):
     assert np.all(home >= arm.position_limit[:, 0]) and np.all(home <= arm.position_limit[:, 1])
 
 
+@pytest.mark.parametrize("name", ("ur5e", *SEVEN))
+def test_every_sensor_package_reads_along_its_joint_axis_on_z(name):
+    """Whatever the maker's link frames (KUKA's pitch joints turn about y, the others' about z),
+    each accelerometer's z is its joint's axis and it sits off the axis on its link: so at the
+    home pose a pitch joint's package reads gravity across the axis, never along it, on every
+    arm, and a model trained on some makers reads another's packages in the same frame."""
+    arm, model = load_arm(name), build_model(name)
+    data = mujoco.MjData(model)
+    data.qpos[:] = model.key("home").qpos
+    mujoco.mj_forward(model, data)
+    for key in arm.joint_keys:
+        site, joint = model.site(f"{key}_sensor").id, model.joint(f"{key}_joint").id
+        z = data.site_xmat[site].reshape(3, 3)[:, 2]
+        np.testing.assert_allclose(z, data.xaxis[joint], atol=1e-9)
+        offset = data.site_xpos[site] - data.xanchor[joint]
+        assert np.linalg.norm(offset - (offset @ z) * z) > 0.02  # off the axis, on the link
+    data.qacc[:] = 0.0  # held still: the accelerometer reads gravity (up) in its mount frame
+    mujoco.mj_inverse(model, data)
+    pitch = [k for k in arm.joint_keys if abs(data.xaxis[model.joint(f"{k}_joint").id][2]) < 0.1]
+    assert len(pitch) >= 2
+    for key in pitch:
+        reading = data.sensor(f"{key}_acc").data
+        assert abs(reading[2]) < 0.5 and np.hypot(reading[0], reading[1]) > 9.5
+
+
 @pytest.mark.parametrize("name", SEVEN)
 def test_the_models_gravity_torques_are_the_descriptions(name):
     """Four poses within the limits (an endless joint across one turn), without and with the
