@@ -41,7 +41,8 @@ def run(cfg: DictConfig) -> None:
                             operating_point=cfg.operating_point,
                             arm=arm_choice(cfg),
                             healthy_rate=cfg.get("healthy_rate"),
-                            contact_margin=cfg.get("contact_margin"))  # fmt: skip
+                            contact_margin=cfg.get("contact_margin"),
+                            normalisation=cfg.get("normalisation", "none"))  # fmt: skip
         atomic_write_json(out / "commissioning.json", record)
     print(commission_summary(record))
 

@@ -30,6 +30,7 @@ from robohealth_mj.data.sensing import load_profile
 from robohealth_mj.deploy.export import export_checkpoint, file_fingerprint
 from robohealth_mj.deploy.operating_point import Reading, check_recipe, match_operating_point
 from robohealth_mj.deploy.recouple import recouple
+from robohealth_mj.deploy.renormalise import MATCHES, healthy_moments, match_healthy
 from robohealth_mj.learn.checkpoint import (
     graph_from_checkpoint,
     load_checked,
@@ -130,14 +131,18 @@ def commission(
     arm: str | None = None,
     healthy_rate: float | None = None,
     contact_margin: float | None = 2.0,
+    normalisation: str = "none",
 ) -> dict[str, Any]:
     """Write ``out_dir/best.ckpt`` (and ``model.onnx`` for a network) commissioned on
     ``healthy``; the commissioning record (also in the checkpoint). A harness model with a
     coupling head also has its ``C`` refitted to the arm's ``placement``
     (:mod:`robohealth_mj.deploy.recouple`). ``arm``: the arm ``healthy`` comes from where it
     names none (a controller log, a bag). ``contact_margin``: the contact watch's thresholds over
-    the healthy running's largest quiet deviations (None: no watch)."""
+    the healthy running's largest quiet deviations (None: no watch). ``normalisation``: how the
+    z-scoring is refitted to the arm's healthy running (:mod:`robohealth_mj.deploy.renormalise`)."""
     check_recipe(operating_point, healthy_rate)  # before minutes of work, not after
+    if normalisation not in MATCHES:
+        raise InputError(f"normalisation: one of {', '.join(MATCHES)}, got {normalisation!r}")
     if contact_margin is not None and not contact_margin > 0:
         raise InputError(f"contact_margin: must be positive (or null), got {contact_margin}")
     ckpt = load_checkpoint(ckpt_path)
@@ -184,6 +189,11 @@ def commission(
     out_dir = Path(out_dir)
     model = model_from_checkpoint(ckpt)
     mean, std = ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()
+    if normalisation != "none":
+        reference_moments = healthy_moments(graph_from_checkpoint(ref_ckpt).transform(ref_x))
+        arm_moments = healthy_moments(graph.transform(arm.x))
+        mean, std = match_healthy(mean, std, reference_moments, arm_moments, normalisation)
+        record["normalisation"] = normalisation
     if graph.coupling is not None and getattr(model, "anomaly", None) is not None:
         graph = replace(graph, coupling=arm_placement(graph, placement))
         drawn = int((ckpt["config"].get("trainer") or {}).get("placements") or 0)

@@ -278,3 +278,41 @@ def test_commissioning_fits_the_contact_watch_and_the_monitor_calls_a_push_with_
     assert not any(off)
     sweeps = commission(ckpt, str(healthy["nominal"]), tmp_path / "s", reference, export=False)
     assert "no quiet of 25 ticks" in sweeps["contact"]["skipped"]
+
+
+def test_a_refitted_normalisation_reads_the_arms_healthy_running_as_the_training_arms(
+    stock_deployed, healthy, tmp_path
+):
+    """``normalisation=moments``: the commissioned checkpoint z-scores this arm's healthy running
+    (a program unlike the training sweeps) to the mean and spread the training normalisation gave
+    the training arms' healthy running, node by node; without it, it does not."""
+    ckpt = stock_deployed["ckpt"]
+    reference = str(Path(stock_deployed["heldout"]).parents[1] / "train_*")
+    trained = load_checkpoint(ckpt)
+    ref = load_recordings(sorted(Path(reference).parent.glob("train_*/graphs.jsonl")))
+    ref_nodes = graph_from_checkpoint(trained).transform(ref.x[~ref.active])
+    z_ref = (ref_nodes - trained["norm_mean"].numpy()) / trained["norm_std"].numpy()
+    live = ref_nodes.std(0) > 1e-3
+    program = load_recordings([healthy["program"] / "graphs.jsonl"]).x
+
+    def z_program(out: str, normalisation: str) -> np.ndarray:
+        record = commission(ckpt, str(healthy["program"]), tmp_path / out, reference,
+                            export=False, normalisation=normalisation)  # fmt: skip
+        done = load_checkpoint(record["checkpoint"])
+        nodes = graph_from_checkpoint(done).transform(program)
+        return (nodes - done["norm_mean"].numpy()) / done["norm_std"].numpy()
+
+    matched, kept = z_program("moments", "moments"), z_program("kept", "none")
+    live &= program.std(0)[: live.shape[0]] > 1e-3
+    np.testing.assert_allclose(matched.mean(0)[live], z_ref.mean(0)[live], atol=1e-3)
+    np.testing.assert_allclose(matched.std(0)[live], z_ref.std(0)[live], rtol=1e-3)
+    assert np.abs(kept.std(0)[live] - z_ref.std(0)[live]).max() > 0.1
+
+
+def test_an_unknown_normalisation_is_one_line(stock_deployed, healthy, capsys):
+    with pytest.raises(SystemExit) as done:
+        commission_main([f"model={stock_deployed['ckpt']}", f"healthy={healthy['nominal']}",
+                         "normalisation=moment"])  # fmt: skip
+    err = capsys.readouterr().err.strip()
+    assert done.value.code == 2 and "\n" not in err
+    assert "normalisation: one of none, sensors, shift, moments, got 'moment'" in err
