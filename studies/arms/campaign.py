@@ -4,7 +4,8 @@ commissioning, and false alarms on the unseen arm's healthy hour.
     python studies/arms/campaign.py [--variants gbdt,stgnn_fixed] [--seeds 42,43,44]
         [--epochs 10] [--sensing full] [--arms ur3e,ur5e,ur10e,ur16e] [--family ARMS]
         [--stages own,loao]
-        [--steps train,rescore,commission,alarms] [--healthy-rate 0.99]
+        [--steps train,rescore,commission,alarms,validate] [--healthy-rate 0.99]
+        [--normalisation sensors|shift|moments]
 
 Reads the per-arm corpora ``outputs/corpus/arms/<arm>`` (``python -m robohealth_mj.corpus
 corpus=arms ...``, see ``studies/arms/run.sh``; ``--corpus`` names another root, e.g. one
@@ -17,7 +18,12 @@ with more training sessions per arm) and writes under ``outputs/campaign_arms``:
   fleet runtime and the monitor's alarms over ``<arm>``'s healthy hour
   (``alarms_healthy_hour_seed*.json``). With ``--healthy-rate R`` the commissioning asks for at
   least R of the arm's healthy windows called healthy (``commission healthy_rate=R``, a quieter
-  operating point) and writes ``commissioned_hr<R>/`` instead.
+  operating point) and writes ``commissioned_hr<R>/`` instead. With ``--normalisation M`` the
+  commissioning also refits the z-scoring to the arm's healthy running (``commission
+  normalisation=M``) into ``commissioned_<M>/``. The ``validate`` step scores each leave-one-arm-out
+  model, before and after commissioning, on the unseen arm's training sessions
+  (``eval_validation.json``): labelled running of that arm that no model here trained on, where a
+  commissioning recipe is chosen before its held-out session is read.
 
 Every step skips what is done, so an interrupted campaign resumes. Training runs through the
 package's own entry points (Hydra multirun, two jobs of one thread).
@@ -95,31 +101,36 @@ def heldout_fingerprint(session: Path) -> str:
     return load_recordings(expand_paths([str(session)])).fingerprint()
 
 
-def commissioned_dir(run_dir: Path, healthy_rate: float | None = None) -> Path:
+def commissioned_dir(
+    run_dir: Path, healthy_rate: float | None = None, normalisation: str = "none"
+) -> Path:
     """Where ``run_dir``'s model commissioned at validation's healthy rate (``None``) or at
-    ``healthy_rate`` lives."""
-    return run_dir / (
-        "commissioned" if healthy_rate is None else f"commissioned_hr{healthy_rate:g}"
-    )
+    ``healthy_rate``, with the z-scoring refitted by ``normalisation`` (``none``: kept), lives."""
+    name = "commissioned" if healthy_rate is None else f"commissioned_hr{healthy_rate:g}"
+    return run_dir / (name if normalisation == "none" else f"{name}_{normalisation}")
 
 
-def commission_and_score(run_dir: Path, arm_dir: Path, healthy_rate: float | None = None) -> None:
+def commission_and_score(
+    run_dir: Path, arm_dir: Path, healthy_rate: float | None = None, normalisation: str = "none"
+) -> None:
     """Commission ``run_dir``'s model on the healthy ten minutes of ``arm_dir`` (one arm's corpus)
     and score it on its held-out session."""
-    done = commissioned_dir(run_dir, healthy_rate)
+    done = commissioned_dir(run_dir, healthy_rate, normalisation)
     rate = [] if healthy_rate is None else [f"healthy_rate={healthy_rate:g}"]
     if not (done / "best.ckpt").is_file():
         run_step("robohealth_mj.commission", f"model={run_dir / 'best.ckpt'}",
                  f"healthy={arm_dir / 'healthy_commissioning_seed940'}", f"out={done}",
-                 *rate)  # fmt: skip
+                 f"normalisation={normalisation}", *rate)  # fmt: skip
     if not (done / "eval_heldout.json").is_file():
         score(done, arm_dir)
 
 
-def score(run_dir: Path, arm_dir: Path) -> None:
-    """``run_dir``'s checkpoint on the held-out session of ``arm_dir``, as ``eval_heldout.json``."""
+def score(run_dir: Path, arm_dir: Path, split: str = "heldout") -> None:
+    """``run_dir``'s checkpoint on the held-out session of ``arm_dir`` as ``eval_heldout.json``,
+    or (``split="validation"``) on its training sessions as ``eval_validation.json``."""
+    data = arm_dir / "heldout_seed900" if split == "heldout" else f"{arm_dir}/train_*"
     run_step("robohealth_mj.evaluate", f"ckpt={run_dir / 'best.ckpt'}",
-             f"data={arm_dir / 'heldout_seed900'}", f"out={run_dir / 'eval_heldout'}")  # fmt: skip
+             f"data={data}", f"out={run_dir / f'eval_{split}'}")  # fmt: skip
 
 
 def healthy_alarms(done: Path, arm_dir: Path) -> None:
@@ -158,8 +169,8 @@ def main() -> None:
     parser.add_argument(
         "--steps",
         default="train,rescore,commission,alarms",
-        help="any of train, rescore, commission, alarms: train alone on a machine that lacks "
-        "the healthy sessions (a lent GPU), then the rest where they are",
+        help="any of train, rescore, commission, alarms, validate: train alone on a machine "
+        "that lacks the healthy sessions (a lent GPU), then the rest where they are",
     )
     parser.add_argument(
         "--override",
@@ -182,6 +193,12 @@ def main() -> None:
         type=float,
         help="commission at this healthy rate (e.g. 0.99) into commissioned_hr<R>/ "
         "(default: validation's rate, into commissioned/)",
+    )
+    parser.add_argument(
+        "--normalisation",
+        default="none",
+        help="commission with the z-scoring refitted to the arm's healthy running: sensors, "
+        "shift or moments (commission normalisation=...), into commissioned_<M>/",
     )
     args = parser.parse_args()
     arms = args.arms.split(",")
@@ -211,9 +228,13 @@ def main() -> None:
             for run_dir in runs(sweep, variants):
                 if "rescore" in steps:
                     rescore(run_dir, root / arm)
-                done = commissioned_dir(run_dir, args.healthy_rate)
+                done = commissioned_dir(run_dir, args.healthy_rate, args.normalisation)
                 if "commission" in steps:
-                    commission_and_score(run_dir, root / arm, args.healthy_rate)
+                    commission_and_score(run_dir, root / arm, args.healthy_rate, args.normalisation)
+                if "validate" in steps:
+                    for scored in (run_dir, done):
+                        if not (scored / "eval_validation.json").is_file():
+                            score(scored, root / arm, "validation")
                 if "alarms" in steps and (done / "model.onnx").is_file():
                     healthy_alarms(done, root / arm)  # networks: a streaming runtime
 

@@ -28,6 +28,18 @@ L="$PY studies/arms/campaign.py --arms $SEVEN --stages loao --seeds 42 --out out
 ($L --variants gbdt --override model.severity=false && $L --variants mlp --epochs 10) &
 $L --variants anomaly_residual --epochs 10
 wait
+# The commissioning's normalisation (none, shift, moments), chosen on the unseen arm's training
+# sessions (validation), and the headline without its per-place node embedding; where each unseen
+# arm's healthy running sits against its training arms' (results/healthy_offsets.md).
+for m in shift moments; do
+  $L --variants gbdt,mlp,anomaly_residual --steps commission,validate --normalisation $m
+done
+$L --variants gbdt,mlp,anomaly_residual --steps validate
+N="${L/campaign_seven/campaign_seven_noemb} --variants anomaly_residual --epochs 10"
+$N --steps train --override model.backbone.node_embedding=false
+$N --steps commission,validate,alarms
+$PY studies/arms/normalisation.py --out outputs/campaign_seven > studies/arms/results/normalisation.md
+$PY studies/arms/healthy_offsets.py --campaign outputs/campaign_seven > studies/arms/results/healthy_offsets.md
 # Leave-one-arm-out over the whole family: the six UR e-Series arms beside the three other
 # seven-joint arms, across joint counts (transfer=true places a UR's six joints on seven places:
 # docs/training.md). To fit 2 cores, the UR arms other than the UR5e bring two training

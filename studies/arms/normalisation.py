@@ -1,0 +1,136 @@
+"""Commissioning with the z-scoring refitted to the unseen arm's healthy running, against the
+commissioning that keeps the training arms' (``studies/arms/campaign.py --normalisation M``).
+
+    python studies/arms/normalisation.py [--out outputs/campaign_seven] [--sensing full]
+
+Per unseen arm and variant, each leave-one-arm-out model uncommissioned, commissioned as before
+(``none``), and commissioned with ``sensors``, ``shift`` and ``moments``
+(``deploy/renormalise.py``): accuracy and localisation on the unseen arm's training sessions
+(validation: labelled running of that arm that no model here trained on) and on its held-out
+session, and the commissioned network's false alarms over the arm's healthy hour where they
+were counted. The recipe is chosen on validation alone, per variant and over all: the mean of
+accuracy and localisation over the unseen arms.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from robohealth_mj.reporting.markdown import heading
+
+ROOT = Path(__file__).resolve().parents[2]
+RESULTS = Path(__file__).resolve().parent / "results"
+RECIPES = {
+    "uncommissioned": ".",
+    "commissioned": "commissioned",
+    "sensors": "commissioned_sensors",
+    "shift": "commissioned_shift",
+    "moments": "commissioned_moments",
+}
+TICK_S = 0.05
+
+
+def _scores(run: Path, split: str) -> tuple[float, float] | None:
+    path = run / f"eval_{split}.json"
+    if not path.is_file():
+        return None
+    m = json.loads(path.read_text())["metrics"]
+    return m["accuracy"], m["localisation_accuracy"]
+
+
+def _false_alarms(done: Path) -> str:
+    alarms = [json.loads(p.read_text()) for p in sorted(done.glob("alarms_*.json"))]
+    if not alarms:
+        return "–"
+    hours = sum(a["settled_healthy_ticks"] for a in alarms) * TICK_S / 3600
+    return f"{sum(a['false_alarms'] for a in alarms) / hours:.2f}"
+
+
+def collect(root: Path) -> list[dict]:
+    """One row per (unseen arm, variant, recipe) with validation and held-out scores."""
+    rows = []
+    for run in sorted(root.glob("*/**/w32/seed*")):
+        if not (run / "best.ckpt").is_file():
+            continue
+        arm, variant = run.relative_to(root).parts[0], run.parts[-3]
+        for recipe, sub in RECIPES.items():
+            done = run / sub
+            val, held = _scores(done, "validation"), _scores(done, "heldout")
+            if val is None or held is None:
+                continue
+            rows.append({"arm": arm, "variant": variant, "recipe": recipe, "val": val,
+                         "heldout": held, "false_alarms": _false_alarms(done)})  # fmt: skip
+    return rows
+
+
+def table(rows: list[dict]) -> str:
+    lines = heading(
+        "Leave-one-arm-out, the commissioning's normalisation (unseen arm)",
+        ["unseen arm", "variant", "recipe", "validation acc.", "validation loc.",
+         "held-out acc.", "held-out loc.", "false alarms / healthy h"],
+    )  # fmt: skip
+    for r in rows:
+        lines.append(
+            f"| {r['arm']} | {r['variant']} | {r['recipe']} | {r['val'][0]:.3f} | "
+            f"{r['val'][1]:.3f} | {r['heldout'][0]:.3f} | {r['heldout'][1]:.3f} | "
+            f"{r['false_alarms']} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def _complete(rows: list[dict]) -> set[tuple[str, str]]:
+    """The (arm, variant) pairs scored under every recipe found: the means compare like with
+    like."""
+    recipes: dict[tuple[str, str], set[str]] = {}
+    for r in rows:
+        recipes.setdefault((r["arm"], r["variant"]), set()).add(r["recipe"])
+    found = {r["recipe"] for r in rows}
+    return {key for key, got in recipes.items() if got == found}
+
+
+def choice(rows: list[dict]) -> str:
+    """Each recipe's mean over the unseen arms, per variant and over all variants, and the pick
+    of each: the best validation mean of accuracy and localisation."""
+    complete, found = _complete(rows), [q for q in RECIPES if q in {r["recipe"] for r in rows}]
+    lines = heading(
+        f"Means over the unseen arms ({len(complete)} models); the pick is validation's",
+        ["variant", "recipe", "validation acc.", "validation loc.", "validation mean",
+         "held-out acc.", "held-out loc.", "picked"],
+    )  # fmt: skip
+    for variant in [*sorted({v for _, v in complete}), "all"]:
+        means, cells = {}, {}
+        for recipe in found:
+            got = [
+                r for r in rows
+                if r["recipe"] == recipe and (r["arm"], r["variant"]) in complete
+                and variant in ("all", r["variant"])
+            ]  # fmt: skip
+            val = np.mean([r["val"] for r in got], axis=0)
+            held = np.mean([r["heldout"] for r in got], axis=0)
+            means[recipe] = float(val.mean())
+            cells[recipe] = (f"{val[0]:.3f} | {val[1]:.3f} | {val.mean():.3f} | {held[0]:.3f} | "
+                             f"{held[1]:.3f}")  # fmt: skip
+        best = max(means, key=means.get)
+        for recipe in found:
+            mark = "yes" if recipe == best else ""
+            lines.append(f"| {variant} | {recipe} | {cells[recipe]} | {mark} |")
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=ROOT / "outputs" / "campaign_seven")
+    parser.add_argument("--sensing", default="full")
+    args = parser.parse_args()
+    rows = collect(args.out / args.sensing / "loao")
+    if not rows:
+        raise SystemExit(f"no scored runs under {args.out / args.sensing / 'loao'}")
+    print(table(rows) + "\n" + choice(rows))
+
+
+if __name__ == "__main__":
+    main()
