@@ -2,6 +2,7 @@
 commissioning that keeps the training arms' (``studies/arms/campaign.py --normalisation M``).
 
     python studies/arms/normalisation.py [--out outputs/campaign_seven] [--sensing full]
+        [--seed 42]
 
 Per unseen arm and variant, each leave-one-arm-out model uncommissioned, commissioned as before
 (``none``), and commissioned with ``sensors``, ``shift`` and ``moments``
@@ -50,10 +51,11 @@ def _false_alarms(done: Path) -> str:
     return f"{sum(a['false_alarms'] for a in alarms) / hours:.2f}"
 
 
-def collect(root: Path) -> list[dict]:
-    """One row per (unseen arm, variant, recipe) with validation and held-out scores."""
+def collect(root: Path, seed: int) -> list[dict]:
+    """One row per (unseen arm, variant, recipe) of seed ``seed``'s models with validation and
+    held-out scores."""
     rows = []
-    for run in sorted(root.glob("*/**/w32/seed*")):
+    for run in sorted(root.glob(f"*/**/w32/seed{seed}")):
         if not (run / "best.ckpt").is_file():
             continue
         arm, variant = run.relative_to(root).parts[0], run.parts[-3]
@@ -125,8 +127,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=ROOT / "outputs" / "campaign_seven")
     parser.add_argument("--sensing", default="full")
+    parser.add_argument("--seed", type=int, default=42)
     args = parser.parse_args()
-    rows = collect(args.out / args.sensing / "loao")
+    rows = collect(args.out / args.sensing / "loao", args.seed)
     if not rows:
         raise SystemExit(f"no scored runs under {args.out / args.sensing / 'loao'}")
     print(table(rows) + "\n" + choice(rows))

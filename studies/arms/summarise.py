@@ -11,8 +11,10 @@ Then each network against ``gbdt`` after commissioning: ahead when the differenc
 exceeds the larger seed std. Also writes ``studies/arms/results/results_<sensing>.csv`` (for another
 ``--out``, ``results_<its name>_<sensing>.csv``). ``--healthy-rate R`` reads the models
 commissioned at that healthy rate (``campaign.py --healthy-rate R``) in place of validation's.
-``--against DIR`` adds each model beside the same model of another campaign root (e.g. one
-trained on fewer sessions per arm): what the recipe changed, per arm, variant and stage.
+``--normalisation M`` reads the models commissioned with that normalisation
+(``campaign.py --normalisation M``). ``--against DIR`` adds each model beside the same model of
+another campaign root (e.g. one trained on fewer sessions per arm): what the recipe changed, per
+arm, variant and stage.
 """
 
 from __future__ import annotations
@@ -238,6 +240,11 @@ def main() -> None:
         "--healthy-rate", type=float, help="the models commissioned at this healthy rate"
     )
     parser.add_argument(
+        "--normalisation",
+        default="none",
+        help="the models commissioned with this normalisation (campaign.py --normalisation M)",
+    )
+    parser.add_argument(
         "--against", type=Path, help="another campaign root to set each model beside"
     )
     parser.add_argument(
@@ -250,6 +257,8 @@ def main() -> None:
     seeds = set(args.seeds.split(",")) if args.seeds else None
     rate = args.healthy_rate
     commissioned = "commissioned" if rate is None else f"commissioned_hr{rate:g}"
+    if args.normalisation != "none":
+        commissioned += f"_{args.normalisation}"
     table = collect(args.sensing, args.out, seeds, commissioned, args.own)
     if not table:
         raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
@@ -257,6 +266,7 @@ def main() -> None:
     recipe = "" if args.out.resolve() == OUT.resolve() else f"{args.out.name}_"
     recipe += f"seeds{'_'.join(sorted(seeds))}_" if seeds else ""
     recipe += f"hr{rate:g}_" if rate is not None else ""
+    recipe += f"{args.normalisation}_" if args.normalisation != "none" else ""
     write_csv(table, RESULTS / f"results_{recipe}{args.sensing}.csv")
     print(markdown(table, args.sensing))
     if any(v == "gbdt" for _, v in table):
