@@ -1,16 +1,17 @@
 """An unseen arm's healthy running z-scored as the training arms' healthy running was, place by
 place: the normalisation refitted at commissioning.
 
-A model read on an arm it never trained on sees each place of the graph at that arm's scale. A
-seven-joint arm's fourth joint carries torques and speeds its training arms' fourth joints never
-did, and the model calls that place faulty whatever the arm does (``studies/arms``: one place
-took 68-99 % of an unseen arm's fault calls). Commissioning has the arm's healthy minutes; this
-refits each node and channel's mean and std so that they map the arm's healthy running onto the
-training arms' healthy running (``shift``: the offset only; ``moments``: offset and spread;
-``sensors``: the offsets of the sensor packages' channels alone, where a maker's frame shows as
-gravity on another axis or of the other sign, while the joint states keep what differs for real,
-the arm's poses and loads, on which its torques depend). With ``moments`` a fault departs from
-the healthy running in units of this arm's own healthy spread.
+A model read on an arm it never trained on sees each place of the graph as that arm runs it. A
+maker's conventions show there: the Gen3's roll axes point down, so its sensor packages read
+gravity of the other sign from its training arms' (983 of their healthy spreads at the base,
+``studies/arms/results/healthy_offsets.md``), and its programs hold other poses and loads.
+Commissioning has the arm's healthy minutes; this refits each node and channel's mean and std so
+that they map the arm's healthy running onto the training arms' healthy running (``shift``: the
+offset only; ``moments``: offset and spread; ``sensors``: the offsets of the sensor packages'
+channels alone, leaving the joint states with what differs for real, the arm's poses and loads).
+With ``moments`` a fault departs from the healthy running in units of this arm's own healthy
+spread. Which one a model gains from is measured in ``studies/arms`` (networks: ``shift``; trees:
+none).
 """
 
 from __future__ import annotations
