@@ -232,8 +232,10 @@ def main() -> None:
                 if "commission" in steps:
                     commission_and_score(run_dir, root / arm, args.healthy_rate, args.normalisation)
                 if "validate" in steps:
-                    for scored in (run_dir, done):
-                        if not (scored / "eval_validation.json").is_file():
+                    for scored in (run_dir, done):  # the commissioned model where it is
+                        if (scored / "best.ckpt").is_file() and not (
+                            scored / "eval_validation.json"
+                        ).is_file():
                             score(scored, root / arm, "validation")
                 if "alarms" in steps and (done / "model.onnx").is_file():
                     healthy_alarms(done, root / arm)  # networks: a streaming runtime
