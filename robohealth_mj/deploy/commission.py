@@ -189,8 +189,9 @@ def commission(
     out_dir = Path(out_dir)
     model = model_from_checkpoint(ckpt)
     mean, std = ckpt["norm_mean"].numpy(), ckpt["norm_std"].numpy()
+    ref_graph = graph_from_checkpoint(ref_ckpt)
     if normalisation != "none":
-        reference_moments = healthy_moments(graph_from_checkpoint(ref_ckpt).transform(ref_x))
+        reference_moments = healthy_moments(ref_graph.transform(ref_x))
         arm_moments = healthy_moments(graph.transform(arm.x))
         mean, std = match_healthy(mean, std, reference_moments, arm_moments, normalisation)
         record["normalisation"] = normalisation
@@ -220,7 +221,7 @@ def commission(
     offset, record["operating_point"] = match_operating_point(
         model,
         int(ckpt["window"]),
-        Reading(ref, graph_from_checkpoint(ref_ckpt), ref_ckpt["norm_mean"].numpy(),
+        Reading(ref, ref_graph, ref_ckpt["norm_mean"].numpy(),
                 ref_ckpt["norm_std"].numpy()),
         list((ckpt.get("split_runs") or {}).get("val", [])),
         Reading(arm, graph, mean, std),

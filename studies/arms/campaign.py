@@ -42,6 +42,7 @@ from robohealth_mj.common.config import compose_config
 from robohealth_mj.common.steps import run_step
 from robohealth_mj.data.arrays import expand_paths, load_recordings
 from robohealth_mj.deploy.alarm_sweep import evaluate_policy, replay_many
+from robohealth_mj.deploy.renormalise import MATCHES
 from robohealth_mj.runtime.alarms import AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
 
@@ -197,6 +198,7 @@ def main() -> None:
     parser.add_argument(
         "--normalisation",
         default="none",
+        choices=MATCHES,
         help="commission with the z-scoring refitted to the arm's healthy running: sensors, "
         "shift or moments (commission normalisation=...), into commissioned_<M>/",
     )

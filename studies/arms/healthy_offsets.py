@@ -21,6 +21,7 @@ import numpy as np
 
 from robohealth_mj import schema
 from robohealth_mj.data.arrays import expand_paths
+from robohealth_mj.deploy.renormalise import FLAT, healthy_moments
 from robohealth_mj.learn.checkpoint import graph_from_checkpoint, load_checked, load_checkpoint
 from robohealth_mj.reporting.markdown import heading
 
@@ -34,17 +35,17 @@ def offsets(ckpt_path: Path, healthy: Path) -> list[tuple[float, str, str, float
     ref = load_checked(ckpt, expand_paths(ckpt["config"]["data"]["train"]))
     arm = load_checked(ckpt, expand_paths([str(healthy)]))
     graph = graph_from_checkpoint(ckpt)
-    ref_x = graph.transform(ref.x[~ref.active]).astype(np.float64)
-    arm_x = graph.transform(arm.x).astype(np.float64)
-    spread = ref_x.std(axis=0)
-    live = spread > 1e-6
-    shift = np.where(live, (arm_x.mean(0) - ref_x.mean(0)) / np.where(live, spread, 1.0), 0.0)
-    ratio = np.where(live, arm_x.std(0) / np.where(live, spread, 1.0), 1.0)
+    (ref_mean, spread), (arm_mean, arm_spread) = (
+        healthy_moments(graph.transform(x)) for x in (ref.x[~ref.active], arm.x)
+    )
+    live = spread > FLAT
+    unit = np.where(live, spread, 1.0)
+    shift = np.where(live, (arm_mean - ref_mean) / unit, 0.0)
+    ratio = np.where(live, arm_spread / unit, 1.0)
     rows = []
     for n, f in zip(*np.nonzero(live), strict=True):
         rows.append((float(shift[n, f]), graph.node_names[n], schema.FEATURE_NAMES[f],
-                     float(ref_x[:, n, f].mean()), float(arm_x[:, n, f].mean()),
-                     float(ratio[n, f])))  # fmt: skip
+                     float(ref_mean[n, f]), float(arm_mean[n, f]), float(ratio[n, f])))  # fmt: skip
     return sorted(rows, key=lambda r: -abs(r[0]))
 
 

@@ -20,17 +20,17 @@ import json
 from pathlib import Path
 
 import numpy as np
+from campaign import commissioned_dir  # this folder's campaign: where each model is written
 
+from robohealth_mj.deploy.renormalise import MATCHES
 from robohealth_mj.reporting.markdown import heading
 
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS = Path(__file__).resolve().parent / "results"
-RECIPES = {
+RECIPES = {  # what each recipe's scores are read from, under a run
     "uncommissioned": ".",
-    "commissioned": "commissioned",
-    "sensors": "commissioned_sensors",
-    "shift": "commissioned_shift",
-    "moments": "commissioned_moments",
+    "commissioned": commissioned_dir(Path()).name,
+    **{m: commissioned_dir(Path(), None, m).name for m in MATCHES if m != "none"},
 }
 TICK_S = 0.05
 

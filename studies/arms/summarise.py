@@ -27,7 +27,9 @@ from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
+from campaign import commissioned_dir  # this folder's campaign: where each model is written
 
+from robohealth_mj.deploy.renormalise import MATCHES
 from robohealth_mj.reporting.markdown import heading
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -242,6 +244,7 @@ def main() -> None:
     parser.add_argument(
         "--normalisation",
         default="none",
+        choices=MATCHES,
         help="the models commissioned with this normalisation (campaign.py --normalisation M)",
     )
     parser.add_argument(
@@ -256,9 +259,7 @@ def main() -> None:
     args = parser.parse_args()
     seeds = set(args.seeds.split(",")) if args.seeds else None
     rate = args.healthy_rate
-    commissioned = "commissioned" if rate is None else f"commissioned_hr{rate:g}"
-    if args.normalisation != "none":
-        commissioned += f"_{args.normalisation}"
+    commissioned = commissioned_dir(Path(), rate, args.normalisation).name
     table = collect(args.sensing, args.out, seeds, commissioned, args.own)
     if not table:
         raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
