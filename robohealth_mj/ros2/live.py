@@ -118,44 +118,43 @@ def run_monitor(
     if not arms:
         raise ValueError("ros2: no arms in this process's partition")
     config = bus_config(cfg)
-    bus = Bus(config)
-    group = MonitorGroup(bus, grouped, arms) if grouped is not None else None
-    watched = group.discover() if group is not None else arms
-    node = MonitorNode(bus, runtime, watched, require_truth=bool(cfg.require_truth),
-                       stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
-                       health_diagnosis_hz=float(cfg.get("health_diagnosis_hz", 20.0)),
-                       tick_hz=float(cfg.get("tick_hz", 20.0)),
-                       diagnose_wait_s=float(cfg.get("diagnose_wait_s", 0.02)),
-                       member=grouped.member if grouped is not None else None,
-                       **layout_options(cfg, tracking, model_arm(runtime)))  # fmt: skip
-    started = time.monotonic()
-    last_report = started
-    secured = f", secured as {config.security.enclave}" if config.security else ""
-    print(f"ros2 monitor: {len(watched)} arms on domain {cfg.domain_id}{secured} "
-          f"({', '.join(watched[:5])}{' …' if len(watched) > 5 else ''}); Ctrl-C to stop",
-          flush=True)  # fmt: skip
-    if group is not None:
-        _say_group(group, node)
-    with stop_on_signals() as stop:
-        try:
-            while not stop.is_set():
-                now = time.monotonic()
-                if duration_s and now - started >= duration_s:
-                    break
-                poll_paced(node, float(cfg.poll_s))  # what arrived in a period, in one go
-                if group is not None and (wanted := group.update()) != list(node.arms):
-                    node.set_arms(wanted)  # a member came or went
-                    _say_group(group, node)
-                if now - last_report >= float(cfg.diagnostics_period_s):
-                    node.publish_diagnostics(time.time())
-                    for arm, problem in node.reported:  # as it happens, not only at the end
-                        print(f"{arm}: {problem}", flush=True)
-                    last_report = now
-        finally:
-            if group is not None:
-                group.leave()  # the others take this monitor's arms now, not after a timeout
-            node.publish_diagnostics(time.time())  # the last word on every arm
-            bus.close()
+    with Bus(config) as bus:  # deleted on a refusal too, not left to the exit
+        group = MonitorGroup(bus, grouped, arms) if grouped is not None else None
+        watched = group.discover() if group is not None else arms
+        node = MonitorNode(bus, runtime, watched, require_truth=bool(cfg.require_truth),
+                           stale_s=float(cfg.stale_s), on_diagnosis=on_diagnosis,
+                           health_diagnosis_hz=float(cfg.get("health_diagnosis_hz", 20.0)),
+                           tick_hz=float(cfg.get("tick_hz", 20.0)),
+                           diagnose_wait_s=float(cfg.get("diagnose_wait_s", 0.02)),
+                           member=grouped.member if grouped is not None else None,
+                           **layout_options(cfg, tracking, model_arm(runtime)))  # fmt: skip
+        started = time.monotonic()
+        last_report = started
+        secured = f", secured as {config.security.enclave}" if config.security else ""
+        print(f"ros2 monitor: {len(watched)} arms on domain {cfg.domain_id}{secured} "
+              f"({', '.join(watched[:5])}{' …' if len(watched) > 5 else ''}); Ctrl-C to stop",
+              flush=True)  # fmt: skip
+        if group is not None:
+            _say_group(group, node)
+        with stop_on_signals() as stop:
+            try:
+                while not stop.is_set():
+                    now = time.monotonic()
+                    if duration_s and now - started >= duration_s:
+                        break
+                    poll_paced(node, float(cfg.poll_s))  # what arrived in a period, in one go
+                    if group is not None and (wanted := group.update()) != list(node.arms):
+                        node.set_arms(wanted)  # a member came or went
+                        _say_group(group, node)
+                    if now - last_report >= float(cfg.diagnostics_period_s):
+                        node.publish_diagnostics(time.time())
+                        for arm, problem in node.reported:  # as it happens, not only at the end
+                            print(f"{arm}: {problem}", flush=True)
+                        last_report = now
+            finally:
+                if group is not None:
+                    group.leave()  # the others take this monitor's arms now, not after a timeout
+                node.publish_diagnostics(time.time())  # the last word on every arm
     return {
         arm: {
             "samples": s.samples,
@@ -195,26 +194,26 @@ def run_robot(cfg: DictConfig, stream: Iterator[tuple[float, GraphSample]]) -> i
     from robohealth_mj.ros2.bus import Bus
     from robohealth_mj.ros2.node import ArmPublisher
 
-    bus = Bus(bus_config(cfg.ros2))
-    arms = [ArmPublisher(bus, arm, **layout_options(cfg.ros2)) for arm in arm_names(cfg.ros2)]
-    wait_for_subscribers([w for arm in arms for w in arm.writers.values()], float(cfg.discovery_s))
-    ticks, started, t0 = 0, time.perf_counter(), None
-    with stop_on_signals() as stop:
-        try:
-            for t, sample in stream:
-                if stop.is_set():
-                    break
-                t0 = t if t0 is None else t0
-                if cfg.speed:
-                    delay = (t - t0) / cfg.speed - (time.perf_counter() - started)
-                    if delay > 0:
-                        time.sleep(delay)
-                for arm in arms:
-                    arm.publish(sample)
-                ticks += 1
-        finally:
-            time.sleep(0.2)  # reliable writers flush before the participant goes
-            bus.close()
+    with Bus(bus_config(cfg.ros2)) as bus:  # deleted on a refusal too, not left to the exit
+        arms = [ArmPublisher(bus, arm, **layout_options(cfg.ros2)) for arm in arm_names(cfg.ros2)]
+        wait_for_subscribers([w for arm in arms for w in arm.writers.values()],
+                             float(cfg.discovery_s))  # fmt: skip
+        ticks, started, t0 = 0, time.perf_counter(), None
+        with stop_on_signals() as stop:
+            try:
+                for t, sample in stream:
+                    if stop.is_set():
+                        break
+                    t0 = t if t0 is None else t0
+                    if cfg.speed:
+                        delay = (t - t0) / cfg.speed - (time.perf_counter() - started)
+                        if delay > 0:
+                            time.sleep(delay)
+                    for arm in arms:
+                        arm.publish(sample)
+                    ticks += 1
+            finally:
+                time.sleep(0.2)  # reliable writers flush before the participant goes
     return ticks
 
 

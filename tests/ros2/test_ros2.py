@@ -289,6 +289,27 @@ def test_simulated_arms_on_loopback_are_diagnosed_and_reported_on_diagnostics(de
         bus.close()
 
 
+def test_a_closed_bus_leaves_the_domain_even_while_its_reader_is_still_held():
+    """A refusal's traceback holds the bus's entities; closing must still delete the
+    participant then, not at the interpreter's exit (where it raced the security plugins)."""
+    from robohealth_mj.ros2.idl import JointState
+
+    config = _bus()
+    robot, monitor = Bus(config), Bus(config)
+    writer = robot.writer("/held/joint_states", JointState)
+    held = monitor.reader("/held/joint_states", JointState)  # as a traceback's frame would
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and not Bus.matched_readers(writer):
+        time.sleep(0.05)
+    assert Bus.matched_readers(writer) == 1
+    with monitor:
+        pass
+    while time.monotonic() < deadline + 10 and Bus.matched_readers(writer):
+        time.sleep(0.05)
+    assert Bus.matched_readers(writer) == 0 and held is not None
+    robot.close()
+
+
 def test_the_ready_set_names_the_readers_holding_data_and_only_those():
     from robohealth_mj.ros2.bus import ReadySet
     from robohealth_mj.ros2.cdr import take_raw
