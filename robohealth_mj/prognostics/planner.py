@@ -64,15 +64,28 @@ def replay_estimates(
     """Replay a life day by day (``days [S]``, ``index [S, J]``) as a monitor sees it: each joint's
     estimate from the days so far. ``online`` maps a joint's history ``[k]`` to the index the
     monitor reads on it (e.g. :func:`robohealth_mj.prognostics.health.monotone_index`)."""
+    return replay_many(days, index, [estimator], online)[0]
+
+
+def replay_many(
+    days: np.ndarray,
+    index: np.ndarray,
+    estimators: Sequence[TrendRul],
+    online: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> list[Replay]:
+    """:func:`replay_estimates` for several estimators, reading each day's history once."""
     index = np.asarray(index, float)
-    low, level = np.full(index.shape, np.inf), np.full(index.shape, np.nan)
-    rising = np.zeros(index.shape, bool)
+    low = [np.full(index.shape, np.inf) for _ in estimators]
+    level = [np.full(index.shape, np.nan) for _ in estimators]
+    rising = [np.zeros(index.shape, bool) for _ in estimators]
     for k in range(len(days)):
         for j in range(index.shape[1]):
             history = index[: k + 1, j]
-            e = estimator.estimate(days[: k + 1], online(history) if online else history)
-            low[k, j], level[k, j], rising[k, j] = e.low, e.level, e.rising
-    return Replay(low, level, rising)
+            seen = online(history) if online else history
+            for e, estimator in enumerate(estimators):
+                r = estimator.estimate(days[: k + 1], seen)
+                low[e][k, j], level[e][k, j], rising[e][k, j] = r.low, r.level, r.rising
+    return [Replay(*arrays) for arrays in zip(low, level, rising, strict=True)]
 
 
 def replay_warnings(

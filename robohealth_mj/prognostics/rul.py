@@ -9,6 +9,11 @@ linear index the interval closes onto the exact crossing.
 A warning is raised when the early bound falls under ``lead_days``, but only on evidence of wear:
 the slope significantly positive and the index above ``floor`` (a healthy joint's index wanders,
 and a line through noise crosses any threshold eventually).
+
+With ``since`` the line is fitted only on the sessions from the first whose index reached it: the
+trend of the wear since it was detected. A mode the model sees only past some severity reads 0
+and then jumps to 0.2-0.3 on the day it is detected; a line through that step is several times
+steeper than the wear and warns weeks early (studies/wear/README.md, the fourth pass).
 """
 
 from __future__ import annotations
@@ -42,22 +47,28 @@ class TrendRul:
     window: int = 10
     min_sessions: int = 3
     z: float = 1.645  # one-sided 95 %
+    since: float | None = None  # fit only from the first session whose index reached this
 
     def __post_init__(self) -> None:
         if not 0 < self.threshold <= 1:
             raise InputError(f"prognostics.threshold must be in (0, 1], got {self.threshold}")
         if self.window < 2 or self.min_sessions < 2:
             raise InputError("prognostics.window and min_sessions must be >= 2")
+        if self.since is not None and not 0 <= self.since < self.threshold:
+            raise InputError(f"the trend's since level must be in [0, threshold), got {self.since}")
 
     def estimate(self, days: np.ndarray, index: np.ndarray) -> RulEstimate:
         """From a joint's sessions so far (``days [S]``, ``index [S]``, oldest first)."""
-        d = np.asarray(days, float)[-self.window :]
-        h = np.asarray(index, float)[-self.window :]
+        d, h = np.asarray(days, float), np.asarray(index, float)
+        last = float(h[np.isfinite(h)][-1]) if np.isfinite(h).any() else math.nan
+        if self.since is not None:
+            start = int(np.argmax(h >= self.since)) if (h >= self.since).any() else len(h)
+            d, h = d[start:], h[start:]
+        d, h = d[-self.window :], h[-self.window :]
         keep = np.isfinite(h)
         d, h = d[keep], h[keep]
         if len(d) < self.min_sessions or np.ptp(d) == 0:
-            level = float(h[-1]) if len(h) else math.nan
-            return RulEstimate(math.inf, math.inf, math.inf, level, 0.0, False)
+            return RulEstimate(math.inf, math.inf, math.inf, last, 0.0, False)
         dc = d - d.mean()
         slope = float((dc * (h - h.mean())).sum() / (dc**2).sum())
         level = float(h.mean() + slope * (d[-1] - d.mean()))

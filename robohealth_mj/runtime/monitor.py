@@ -258,7 +258,11 @@ class SessionWear:
         self.index = FittedIndex.load(cal) if cal else None  # how the index is read (studies/wear)
         self.tracker = HealthTracker(
             Path(cfg.state_dir),
-            TrendRul(threshold=float(cfg.threshold)),
+            TrendRul(
+                threshold=float(cfg.threshold),
+                min_sessions=int(cfg.get("min_sessions", 3)),
+                since=float(cfg.floor) if cfg.get("fit_since_floor") else None,
+            ),
             lead_days=float(cfg.lead_days),
             floor=float(cfg.floor),
             monotone=bool(self.index and self.index.model.monotone),

@@ -10,12 +10,12 @@ Steps (each skipped when done): train ``--variant`` on every day of the training
 raw index, its bootstrap band, the index split by mechanical mode and over only the windows in
 which the joint turned); fit the channels' scales and the four modes' signatures on the standard
 corpus and the training lives (``channel_scales.json``, ``signatures.json``). Then for each way of
-reading the index
-(``robohealth_mj/prognostics/index_model.py``): fit its calibration on the training lives' days in
-the model's validation split and the validation lives (each validation life read through the maps
-fitted without it), tune the warning's lead time and floor on the validation lives, and replay
-every life day by day as the monitor runs it,
-on every joint: the index against the truth (on the wearing joint, and how high the others read),
+reading the index (``robohealth_mj/prognostics/index_model.py``): fit its calibration on the
+training lives' days in the model's validation split and the validation lives (each validation
+life read through the maps fitted without it), tune the warning's lead time, floor and trend
+(through the last sessions or since the index reached the floor; through at least 3 or 5
+sessions) on the validation lives, and replay every life day by day as the monitor runs it, on
+every joint: the index against the truth (on the wearing joint, and how high the others read),
 each wearing life's first warning on any joint judged against the 5-20 day band (``in_band``,
 ``early``, ``late``, ``wrong_joint``, ``missed``), and warnings per 100 healthy arm-days. The index
 model is chosen on the validation lives; the held-out lives (the corpus's) and the fresh lives
@@ -29,7 +29,7 @@ import argparse
 import json
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -64,7 +64,7 @@ from robohealth_mj.prognostics.planner import (
     Replay,
     first_warning,
     outcome_shares,
-    replay_estimates,
+    replay_many,
 )
 from robohealth_mj.prognostics.rul import TrendRul
 from robohealth_mj.prognostics.signature import LOAD_DAYS, Signatures, adapt, fit_signatures
@@ -226,18 +226,39 @@ class LifeView:
     days: np.ndarray
     truth: np.ndarray
     seen: np.ndarray
-    replay: Replay
+    replays: dict[tuple, Replay]  # per trend setting (:func:`trend_settings`)
+
+
+LEADS = (4.0, 6.0, 8.0, 10.0, 12.0, 15.0, 20.0, 25.0, 30.0)
+FLOORS = (0.0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5)
+FITS = ("window", "since")  # the trend's sessions: the last ones, or those since detection
+MIN_SESSIONS = (3, 5)  # the fewest sessions a trend is drawn through: the estimator's least, a week
+
+
+def trend_settings() -> list[tuple[str, int, float | None]]:
+    """Every trend a warning can read: (fit, fewest sessions, the since level or None)."""
+    floors = [f for f in FLOORS if f > 0]  # since 0 is every session: the window's fit
+    return [("window", m, None) for m in MIN_SESSIONS] + [
+        ("since", m, f) for m in MIN_SESSIONS for f in floors
+    ]
+
+
+def trend_of(est: TrendRul, fit: str, min_sessions: int, floor: float) -> TrendRul:
+    """The estimator a warning setting reads (the since level is the warning's floor)."""
+    return replace(est, min_sessions=min_sessions, since=floor if fit == "since" else None)
 
 
 def view(life: dict, index: FittedIndex, est: TrendRul) -> LifeView:
     days = np.array([d["day"] for d in life["days"]], float)
     daily = np.stack([index.calibrate(d) for d in life["days"]])
+    settings = trend_settings()
+    trends = [trend_of(est, fit, m, level or 0.0) for fit, m, level in settings]
     return LifeView(
         life,
         days,
         np.array([d["truth"] for d in life["days"]]),
         index.life(life["days"]),
-        replay_estimates(days, daily, est, index.online),
+        dict(zip(settings, replay_many(days, daily, trends, index.online), strict=True)),
     )
 
 
@@ -275,13 +296,21 @@ def index_figures(views: list[LifeView]) -> dict:
     }
 
 
-def warning_figures(views: list[LifeView], lead: float, floor: float, band=DEFAULT_BAND) -> dict:
+def warning_figures(
+    views: list[LifeView],
+    lead: float,
+    floor: float,
+    fit: str = "window",
+    min_sessions: int = MIN_SESSIONS[0],
+    band=DEFAULT_BAND,
+) -> dict:
     """Each wearing life's first warning on any joint, classified (:mod:`planner`), and the
     warnings on healthy arm-days (healthy lives, and wearing lives' days before onset)."""
     firsts, per_life, healthy_days, warned_days = [], [], 0, 0
+    setting = (fit, min_sessions, floor if fit == "since" else None)
     for v in views:
         life = v.life
-        warned = v.replay.warned(lead, floor)
+        warned = v.replays[setting].warned(lead, floor)
         before_onset = ~v.truth.any(axis=1)
         healthy_days += int(before_onset.sum())
         warned_days += int((warned.any(axis=1) & before_onset).sum())
@@ -292,9 +321,13 @@ def warning_figures(views: list[LifeView], lead: float, floor: float, band=DEFAU
             per_life.append({"life": life["name"], "mode": life["mode"], "joint": life["joint"],
                              "path": life["path"], "failure_day": life["failure_day"],
                              **vars(first)})  # fmt: skip
+    centre = sum(band) / 2
+    off = [abs(w.lead_days - centre) if w.outcome != "wrong_joint" and w.lead_days is not None
+           else centre for w in firsts]  # fmt: skip
     return {
         "lives": len(firsts),
         **outcome_shares(firsts),
+        "off_centre_days": float(np.mean(off)) if off else 0.0,
         "healthy_arm_days": healthy_days,
         "warned_healthy_days": warned_days,
         "warnings_per_100_healthy_days": 100 * warned_days / max(healthy_days, 1),
@@ -302,34 +335,48 @@ def warning_figures(views: list[LifeView], lead: float, floor: float, band=DEFAU
     }
 
 
-LEADS = (4.0, 6.0, 8.0, 10.0, 12.0, 15.0, 20.0, 25.0, 30.0)
-FLOORS = (0.0, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5)
-
-
-def tune_warning(views: list[LifeView], band=DEFAULT_BAND) -> dict:
-    """Lead time and floor chosen on the validation lives: the most lives first warned inside
-    the band on the right joint, then the fewest healthy-day warnings, then the fewest early
-    warnings; among settings tied on all three, the middle lead time, then the middle floor (so
-    that a tie does not put the pick at a grid's edge). ``at_edge`` says if the pick is there."""
+def tune_warning(
+    views: list[LifeView],
+    fits: tuple[str, ...] = FITS,
+    min_sessions: tuple[int, ...] = MIN_SESSIONS,
+    band=DEFAULT_BAND,
+) -> dict:
+    """Lead time, floor and the trend (its fit and fewest sessions) chosen on the validation
+    lives: the most lives first warned inside the band on the right joint, then the fewest
+    healthy-day warnings, then the first warnings nearest the band's centre on average (a
+    missed or wrong-joint life counts as far as the centre is from failure): of settings equal
+    on the count, the one with the most room either side. Among settings tied on all three, the
+    last sessions' fit over the fit since detection and the fewer sessions (the simpler rule),
+    then the middle lead time, then the middle floor (so that a tie does not put the pick at a
+    grid's edge). ``at_edge`` says if the pick is there."""
     scored = []
-    for lead in LEADS:
-        for floor in FLOORS:
-            f = warning_figures(views, lead, floor, band)
-            key = (round(f["in_band"], 6), -round(f["warnings_per_100_healthy_days"], 6),
-                   -round(f["early"], 6))  # fmt: skip
-            scored.append((key, lead, floor))
+    for fit, m, level in trend_settings():
+        if fit not in fits or m not in min_sessions:
+            continue
+        for lead in LEADS:
+            for floor in FLOORS if level is None else [level]:
+                f = warning_figures(views, lead, floor, fit, m, band)
+                key = (round(f["in_band"], 6), -round(f["warnings_per_100_healthy_days"], 6),
+                       -round(f["off_centre_days"], 6))  # fmt: skip
+                scored.append((key, fit, m, lead, floor))
     best = max(k for k, *_ in scored)
-    tied = [(lead, floor) for k, lead, floor in scored if k == best]
-    leads = sorted({lead for lead, _ in tied})
+    tied = [setting for k, *setting in scored if k == best]
+    fit = next(f for f in fits if any(t[0] == f for t in tied))
+    m = next(m for m in min_sessions if any(t[:2] == [fit, m] for t in tied))
+    tied = [t for t in tied if t[:2] == [fit, m]]
+    leads = sorted({t[2] for t in tied})
     lead = leads[len(leads) // 2]
-    floors = sorted(floor for tied_lead, floor in tied if tied_lead == lead)
+    floors = sorted(t[3] for t in tied if t[2] == lead)
     floor = floors[len(floors) // 2]
+    edge_floors = (FLOORS[0] if fit == "window" else FLOORS[1], FLOORS[-1])
     return {
+        "fit": fit,
+        "min_sessions": m,
         "lead_days": lead,
         "floor": floor,
         "in_band": best[0],
         "tied_settings": len(tied),
-        "at_edge": lead in (LEADS[0], LEADS[-1]) or floor in (FLOORS[0], FLOORS[-1]),
+        "at_edge": lead in (LEADS[0], LEADS[-1]) or floor in edge_floors,
     }
 
 
@@ -357,19 +404,35 @@ def evaluate_variant(
     est: TrendRul,
     channels: ChannelFits = NO_CHANNELS,
 ) -> dict:
-    """Fit, tune on the validation lives, report on every group of lives."""
+    """Fit, tune on the validation lives, report on every group of lives; ``ablation``: the
+    warnings tuned on the last sessions' trend alone, then with the fit since detection, then
+    with either fewest sessions too (what the tuning reads today)."""
     indexes = fitted_indexes(model, scores, cal_days, channels)
     views = {name: [view(life, indexes[life["name"]], est) for life in lives_of(scores, roles)]
              for name, roles in GROUPS.items()}  # fmt: skip
-    tuned = tune_warning(views["validation"])
-    lead, floor = tuned["lead_days"], tuned["floor"]
+
+    def tuned_warnings(fits: tuple[str, ...], mins: tuple[int, ...]) -> dict:
+        tuned = tune_warning(views["validation"], fits, mins)
+        setting = (tuned["lead_days"], tuned["floor"], tuned["fit"], tuned["min_sessions"])
+        figures = {name: warning_figures(v, *setting) for name, v in views.items()}
+        return {"warning": tuned, "warnings": figures}
+
+    ablation = {
+        "last sessions": tuned_warnings(("window",), MIN_SESSIONS[:1]),
+        "+ since the floor": tuned_warnings(FITS, MIN_SESSIONS[:1]),
+        f"+ fewest sessions {' or '.join(map(str, MIN_SESSIONS))}": tuned_warnings(
+            FITS, MIN_SESSIONS
+        ),
+    }
+    chosen = list(ablation.values())[-1]
     return {
         "index_model": model.name,
-        "warning": tuned,
+        "warning": chosen["warning"],
         "groups": {
-            name: {"index": index_figures(v), "warnings": warning_figures(v, lead, floor)}
+            name: {"index": index_figures(v), "warnings": chosen["warnings"][name]}
             for name, v in views.items()
         },
+        "ablation": ablation,
         "_index": indexes["_all"],
     }
 
@@ -491,7 +554,10 @@ def main() -> None:
     rows = [evaluate_variant(m, scores, cal_days, trend, channels)
             for m in tqdm(variants, desc="index models", disable=None)]  # fmt: skip
     chosen = choose(rows)
-    estimators = {"trend": trend}
+    warning = chosen["warning"]
+    estimators = {  # as the chosen warning reads the trend
+        "trend": trend_of(trend, warning["fit"], warning["min_sessions"], warning["floor"])
+    }
     if "progpy" in args.estimators.split(","):
         from robohealth_mj.prognostics.progpy_rul import ProgpyRul
 
@@ -511,6 +577,8 @@ def main() -> None:
         "calibration": fitted.to_json(),
         "lead_days": chosen["warning"]["lead_days"],
         "floor": chosen["warning"]["floor"],
+        "fit": chosen["warning"]["fit"],  # monitor health.fit_since_floor=true when "since"
+        "min_sessions": chosen["warning"]["min_sessions"],  # monitor health.min_sessions
         "rul": [row for name, roles in GROUPS.items() if name != "validation"
                 for row in rul_rows(lives_of(scores, roles), fitted, estimators, name,
                                     first_by_life(chosen["groups"][name]))],
@@ -520,7 +588,8 @@ def main() -> None:
     for r in rows:
         g = r["groups"]
         print(
-            f"{r['index_model']:28s} lead {r['warning']['lead_days']:4.0f} floor "
+            f"{r['index_model']:28s} {r['warning']['fit']:6s} min "
+            f"{r['warning']['min_sessions']} lead {r['warning']['lead_days']:4.0f} floor "
             f"{r['warning']['floor']:.2f} | "
             + " | ".join(
                 f"{n}: mae {g[n]['index']['wearing_joint_mae']:.3f} in-band "

@@ -22,6 +22,19 @@ from robohealth_mj.reporting.markdown import heading
 GROUPS = ("validation", "held_out", "fresh")
 
 
+def _tune(w: dict) -> str:
+    """A tuned warning: lead days, floor, the trend's fit (the last sessions or since the floor
+    was reached) and the fewest sessions it is drawn through."""
+    return (
+        f"{w['lead_days']:g}, {w['floor']:g}, {w.get('fit', 'window')} ≥ {w.get('min_sessions', 3)}"
+    )
+
+
+def _share_in_band(outcomes: list[str]) -> str:
+    hits = sum(o == "in_band" for o in outcomes)
+    return f"{hits / len(outcomes):.2f} ({hits}/{len(outcomes)})"
+
+
 def _fmt(values: list[float], digits: int = 3) -> str:
     if len(values) == 1:
         return f"{values[0]:.{digits}f}"
@@ -29,7 +42,7 @@ def _fmt(values: list[float], digits: int = 3) -> str:
 
 
 def ablation(runs: list[dict]) -> list[str]:
-    head = ["index model", "chosen on seeds", "lead, floor (per seed)"]
+    head = ["index model", "chosen on seeds", "lead, floor, fit ≥ sessions (per seed)"]
     for g in GROUPS:
         head += [f"{g}: wearing-joint MAE", f"{g}: in band", f"{g}: early / late / wrong / missed",
                  f"{g}: warnings / 100 healthy d"]  # fmt: skip
@@ -38,7 +51,7 @@ def ablation(runs: list[dict]) -> list[str]:
     for name in names:
         rows = [next(r for r in run["index_models"] if r["index_model"] == name) for run in runs]
         chosen = [str(run["seed"]) for run in runs if run["chosen"] == name]
-        tune = "; ".join(f"{r['warning']['lead_days']:g}, {r['warning']['floor']:g}" for r in rows)
+        tune = "; ".join(_tune(r["warning"]) for r in rows)
         cells = [f"**{name}**" if chosen else name, ", ".join(chosen) or "—", tune]
         for g in GROUPS:
             w = [r["groups"][g]["warnings"] for r in rows]
@@ -56,7 +69,7 @@ def ablation(runs: list[dict]) -> list[str]:
 
 
 def targets(runs: list[dict]) -> list[str]:
-    head = ["seed", "index model", "lead, floor", "at grid edge"]
+    head = ["seed", "index model", "lead, floor, fit ≥ sessions", "at grid edge"]
     for g in ("held_out", "fresh"):
         head += [f"{g}: wearing-joint MAE (≤ 0.05)", f"{g}: other joints read (mean, p95)",
                  f"{g}: in band (≥ 0.90)", f"{g}: warnings / 100 healthy d (≤ 1)"]  # fmt: skip
@@ -64,8 +77,7 @@ def targets(runs: list[dict]) -> list[str]:
     for run in runs:
         row = next(r for r in run["index_models"] if r["index_model"] == run["chosen"])
         w = row["warning"]
-        cells = [str(run["seed"]), run["chosen"], f"{w['lead_days']:g}, {w['floor']:g}",
-                 "yes" if w["at_edge"] else "no"]  # fmt: skip
+        cells = [str(run["seed"]), run["chosen"], _tune(w), "yes" if w["at_edge"] else "no"]
         for g in ("held_out", "fresh"):
             i, x = row["groups"][g]["index"], row["groups"][g]["warnings"]
             cells += [
@@ -76,6 +88,36 @@ def targets(runs: list[dict]) -> list[str]:
                 f"{x['healthy_arm_days']} d)",
             ]
         lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def _step(name: str) -> int:
+    """The ablation's steps in the order they were added (JSON keeps its keys sorted)."""
+    first = ("last sessions", "+ since the floor")
+    return first.index(name) if name in first else len(first)
+
+
+def fit_ablation(runs: list[dict]) -> list[str]:
+    """The chosen index model's warning tuned on the validation lives with the trend through
+    the last sessions only, then also since the index reached the floor, then also through at
+    least five sessions (the campaign's ``ablation``)."""
+    head = ["seed", "warning tuned over", "lead, floor, fit ≥ sessions"]
+    for g in GROUPS:
+        head += [f"{g}: in band", f"{g}: early / late / wrong / missed"]
+    head.append("held_out: warnings / 100 healthy d")
+    lines = heading("The warning's trend (chosen index model; tuned on the validation lives)", head)
+    for run in runs:
+        row = next(r for r in run["index_models"] if r["index_model"] == run["chosen"])
+        steps = sorted(row.get("ablation", {}).items(), key=lambda kv: _step(kv[0]))
+        for name, option in steps:
+            cells = [str(run["seed"]), name, _tune(option["warning"])]
+            for g in GROUPS:
+                x = option["warnings"][g]
+                cells += [f"{x['in_band']:.2f} ({round(x['in_band'] * x['lives'])}/{x['lives']})",
+                          " / ".join(f"{x[o]:.2f}" for o in ("early", "late", "wrong_joint",
+                                                            "missed"))]  # fmt: skip
+            cells.append(f"{option['warnings']['held_out']['warnings_per_100_healthy_days']:.2f}")
+            lines.append("| " + " | ".join(cells) + " |")
     return lines
 
 
@@ -116,10 +158,11 @@ def observable(runs: list[dict], unobservable: list[tuple[str, str]]) -> list[st
     """The chosen index's wearing-joint MAE (every day of every life weighs the same) with and
     without the lives of the (mode, joint) pairs no channel can read (argued from the channels'
     response in ``severity_channels.md``)."""
-    head = ["seed", "group", "wearing-joint MAE", "lives left out", "MAE without them"]
+    head = ["seed", "group", "wearing-joint MAE", "in band", "lives left out",
+            "MAE without them", "in band without them"]  # fmt: skip
     pairs = ", ".join(f"{m} at {j}" for m, j in unobservable) or "none"
     lines = heading(
-        f"The wearing-joint MAE on what the channels can read (left out: {pairs})", head
+        f"The planner's figures on what the channels can read (left out: {pairs})", head
     )
     for run in runs:
         for g in ("held_out", "fresh"):
@@ -127,8 +170,10 @@ def observable(runs: list[dict], unobservable: list[tuple[str, str]]) -> list[st
             keep = [r for r in rows if (r["mode"], r["joint"]) not in unobservable]
             err = lambda rs: np.abs(np.concatenate([np.subtract(r["index"], r["truth"])  # noqa: E731
                                                     for r in rs])).mean()  # fmt: skip
-            cells = [str(run["seed"]), g, f"{err(rows):.3f}", str(len(rows) - len(keep)),
-                     f"{err(keep):.3f}" if keep else "—"]  # fmt: skip
+            band = lambda rs: _share_in_band([r["first_warning_outcome"] for r in rs])  # noqa: E731
+            cells = [str(run["seed"]), g, f"{err(rows):.3f}", band(rows),
+                     str(len(rows) - len(keep)), f"{err(keep):.3f}" if keep else "—",
+                     band(keep) if keep else "—"]  # fmt: skip
             lines.append("| " + " | ".join(cells) + " |")
     return lines
 
@@ -148,7 +193,8 @@ def main() -> None:
                      f"Runs: {', '.join(str(p) for p in args.runs)}. Band: "
                      f"{runs[0]['band_days'][0]:g}-{runs[0]['band_days'][1]:g} days before "
                      "failure, the first warning on any joint.", "",
-                     *targets(runs), "", *observable(runs, unobservable), "", *ablation(runs), "",
+                     *targets(runs), "", *observable(runs, unobservable), "",
+                     *fit_ablation(runs), "", *ablation(runs), "",
                      *strata(runs), "",
                      *per_life(runs)]))  # fmt: skip
 

@@ -60,3 +60,20 @@ def test_the_wear_index_never_falls_and_uses_only_the_days_so_far():
     assert np.isclose(seen[2], 0.25) and seen[1] == 0.3  # day 1 read before day 2 was known
     with_gap = monotone_index(np.array([0.2, np.nan, 0.1]))
     assert np.isnan(with_gap[1]) and np.allclose(with_gap[[0, 2]], 0.15)
+
+
+def test_a_trend_fitted_since_detection_does_not_warn_weeks_early_on_the_detection_step():
+    """A mode the model reads only past some severity: 0 for ten days while the joint wears,
+    then a step to the truth. A line through the step warns far ahead of failure; the line
+    through the days since the index reached the floor warns inside the band."""
+    days, index = _life(wearing=1, rate=0.02, days=40)  # failure (0.8) on day 40
+    index[:10, 1] = 0.0
+    late = WarningRule(TrendRul(threshold=0.8), lead_days=15, floor=0.15)
+    since = WarningRule(TrendRul(threshold=0.8, since=0.15), lead_days=15, floor=0.15)
+    step = first_warning(days, replay_warnings(days, index, late), 1, 40.0)
+    detected = first_warning(days, replay_warnings(days, index, since), 1, 40.0)
+    assert step.outcome == "early" and step.lead_days > 25
+    assert detected.outcome == "in_band" and detected.warned_joint == 1
+    # a joint that never reached the level has no trend (and keeps its last reading)
+    healthy = TrendRul(since=0.15).estimate(days, index[:, 3])
+    assert not healthy.rising and healthy.level == index[-1, 3]

@@ -131,3 +131,33 @@ def test_the_monitor_hands_the_index_the_last_days_channel_readings(tmp_path):
     recent = seen[-1]["recent_channel"]
     assert len(recent) == LOAD_DAYS and recent[-1] is seen[-1]["channel"]
     assert [r[load, elbow] for r in recent] == pytest.approx([11.0, 12.0, 13.0, 14.0, 15.0])
+
+
+def test_health_fit_since_floor_reads_the_trend_from_the_day_wear_was_detected(tmp_path):
+    """A joint read at 0 for ten days, then stepping onto its wear (0.02 a day, failing on day
+    40): by day 14 the last ten sessions' line through the step warns, 26 days ahead; with
+    ``health.fit_since_floor`` the line through the days since the floor does not yet."""
+    from robohealth_mj.common.config import compose_config
+
+    warned = {}
+    for since in (False, True):
+        overrides = [f"health.state_dir={tmp_path / str(since)}", "health.day=0",
+                     "health.lead_days=15", "health.floor=0.2", "health.min_sessions=3",
+                     f"health.fit_since_floor={str(since).lower()}"]  # fmt: skip
+        tracker = SessionWear("arm1", compose_config("monitor", overrides).health).tracker
+        for day in range(15):
+            joints = tracker.update("arm1", day, _session(0.02 * day if day >= 10 else 0.0))
+        warned[since] = joints[2].warning
+    assert warned == {False: True, True: False}
+
+
+def test_health_min_sessions_draws_no_trend_through_fewer_sessions(tmp_path):
+    """``health.min_sessions=5`` with the fit since the floor: four sessions past detection give
+    no RUL yet, the fifth gives one."""
+    from robohealth_mj.common.config import compose_config
+
+    overrides = [f"health.state_dir={tmp_path}", "health.day=0", "health.fit_since_floor=true",
+                 "health.floor=0.2", "health.min_sessions=5"]  # fmt: skip
+    tracker = SessionWear("arm1", compose_config("monitor", overrides).health).tracker
+    ruls = [tracker.update("arm1", day, _session(0.3 + 0.02 * day))[2].rul.rul for day in range(5)]
+    assert np.isinf(ruls[3]) and ruls[4] == pytest.approx((0.8 - 0.38) / 0.02)
