@@ -173,15 +173,22 @@ def _say_group(group: Any, node: Any) -> None:
           f"{', '.join(members)}", flush=True)  # fmt: skip
 
 
+SETTLE_S = 0.5  # after the writers matched, for the readers to match them back
+
+
 def wait_for_subscribers(writers: list[Any], timeout_s: float) -> bool:
     """Until every writer has matched a reader (on a secured graph: its keys exchanged), at
     most ``timeout_s``: what is written before a reader matches never reaches it. Whether all
-    did."""
+    did. Then :data:`SETTLE_S` more: a writer matches a reader before the reader has matched it
+    back, and a reader that has not yet gets the first samples late, after newer ones (Cyclone
+    catching up a late-matched writer; once in the suite, eight ``fault_state`` samples "went
+    backwards" at a monitor stopped 0.3 s in every 1.2 s)."""
     from robohealth_mj.ros2.bus import Bus
 
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         if all(Bus.matched_readers(w) for w in writers):
+            time.sleep(SETTLE_S)
             return True
         time.sleep(0.05)
     return False
