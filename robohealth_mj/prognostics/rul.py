@@ -52,10 +52,12 @@ class TrendRul:
     def __post_init__(self) -> None:
         if not 0 < self.threshold <= 1:
             raise InputError(f"prognostics.threshold must be in (0, 1], got {self.threshold}")
-        if self.window < 2 or self.min_sessions < 2:
-            raise InputError("prognostics.window and min_sessions must be >= 2")
+        if self.window < 2 or not 2 <= self.min_sessions <= self.window:
+            raise InputError(f"health.min_sessions must be >= 2 (and at most the trend's window, "
+                             f"{self.window}), got {self.min_sessions}")  # fmt: skip
         if self.since is not None and not 0 <= self.since < self.threshold:
-            raise InputError(f"the trend's since level must be in [0, threshold), got {self.since}")
+            raise InputError(f"health.floor must be in [0, health.threshold) to fit the trend "
+                             f"since it, got {self.since}")  # fmt: skip
 
     def estimate(self, days: np.ndarray, index: np.ndarray) -> RulEstimate:
         """From a joint's sessions so far (``days [S]``, ``index [S]``, oldest first)."""

@@ -485,7 +485,18 @@ def test_monitor_reads_the_index_through_a_fitted_index_file(deployed, tmp_path)
     assert np.isfinite(signed).all() and max(signed) < 0.2
 
 
-def test_monitor_health_without_a_day_is_one_line(deployed, tmp_path, capsys):
+@pytest.mark.parametrize(
+    ("extra", "named"),
+    [
+        ([], "health.day"),
+        (["health.day=0", "health.min_sessions=1"], "health.min_sessions"),
+        (["health.day=0", "health.min_sessions=11"], "health.min_sessions"),
+        (["health.day=0", "health.floor=0.9"], "health.floor"),
+    ],
+)
+def test_monitor_health_settings_that_cannot_work_are_one_line(
+    deployed, tmp_path, capsys, extra, named
+):
     with pytest.raises(SystemExit) as exc:
         monitor_main(
             [
@@ -493,8 +504,9 @@ def test_monitor_health_without_a_day_is_one_line(deployed, tmp_path, capsys):
                 "source=sim",
                 "duration_s=2",
                 f"health.state_dir={tmp_path}",
+                *extra,
             ]
         )
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "health.day" in err[0]
+    assert len(err) == 1 and named in err[0], err
