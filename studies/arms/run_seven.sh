@@ -2,10 +2,11 @@
 # Issue 65, item 4: each seven-joint arm's own models beside the UR5e's, the UR5e's models read
 # on each seven-joint arm, and leave-one-arm-out over the four seven-joint arms (trained on the
 # other three, read by place along the chain), before and after commissioning, with false alarms
-# over the unseen arm's healthy hour; from a fresh clone, about two hours on 2 cores.
+# over the unseen arm's healthy hour; from a fresh clone, about four hours on 2 cores.
 # Each arm's corpus is conf/corpus/arms.yaml without the probe (the quick corpus's eight training
 # sessions and held-out session, ten healthy minutes to commission on, a healthy hour);
-# W = 32, seed 42, the networks at 10 epochs, one thread each, two at a time. The tables:
+# W = 32, seed 42 (leave-one-arm-out: seeds 42-44; LOAO_SEEDS=42 for one, about two hours less),
+# the networks at 10 epochs, one thread each, two at a time. The tables:
 # studies/arms/results/seven_joint_own.md and seven_joint_loao.md. Leave-one-arm-out with the
 # six-joint UR arms among the training arms is not in it: see studies/arms/README.md.
 set -euo pipefail
@@ -24,7 +25,8 @@ wait
 # scored on the unseen arm, commissioned on its ten healthy minutes, scored again, and the
 # networks' alarms counted over its healthy hour.
 SEVEN=fr3,iiwa14,gen3,xarm7
-L="$PY studies/arms/campaign.py --arms $SEVEN --stages loao --seeds 42 --out outputs/campaign_seven"
+LS=${LOAO_SEEDS:-42,43,44}
+L="$PY studies/arms/campaign.py --arms $SEVEN --stages loao --seeds $LS --out outputs/campaign_seven"
 ($L --variants gbdt --override model.severity=false && $L --variants mlp --epochs 10) &
 $L --variants anomaly_residual --epochs 10
 wait
@@ -51,6 +53,7 @@ for arm in ur3e ur10e ur16e ur20 ur30; do
 done
 F="$L --family ur5e,ur3e,ur10e,ur16e,ur20,ur30,$SEVEN"
 F="${F/campaign_seven/campaign_family}"
+F="${F/--seeds $LS/--seeds 42}"  # the family at one seed (2.5 h)
 ($F --variants gbdt --override model.severity=false && $F --variants mlp --epochs 10) &
 $F --variants anomaly_residual --epochs 10
 wait
