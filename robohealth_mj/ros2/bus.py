@@ -251,12 +251,13 @@ class Bus:
         last reference is not enough."""
         entity.__del__()
 
-    def close(self) -> None:
-        """Delete the participant (and with it every reader, writer and topic) now. A refusal's
-        traceback holds the bus, so waiting for the last reference leaves the participant to
-        the interpreter's exit, where it raced the security plugins' threads (a segfault after
-        the one-line error, one run in eight with a secured peer on the domain)."""
-        if self.participant is not None:
+    def close(self, now: bool = False) -> None:
+        """Let the participant go (and with it every reader, writer and topic). ``now``: delete
+        it at once, even while other references remain. A refusal's traceback holds the bus, so
+        waiting for the last reference left the participant to the interpreter's exit, where it
+        raced the security plugins' threads (a segfault after the one-line error, one run in
+        eight with a secured peer on the domain)."""
+        if now and self.participant is not None:
             self.delete(self.participant)
         self._topics.clear()
         self.participant = None
@@ -265,8 +266,8 @@ class Bus:
     def __enter__(self) -> Bus:
         return self
 
-    def __exit__(self, *_exc: object) -> None:
-        self.close()
+    def __exit__(self, exc_type: type | None, *_exc: object) -> None:
+        self.close(now=exc_type is not None)  # on an error, at once (see close)
 
 
 class ReadySet:

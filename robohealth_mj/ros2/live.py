@@ -118,7 +118,7 @@ def run_monitor(
     if not arms:
         raise ValueError("ros2: no arms in this process's partition")
     config = bus_config(cfg)
-    with Bus(config) as bus:  # deleted on a refusal too, not left to the exit
+    with Bus(config) as bus:  # deleted at once on a refusal, not left to the exit
         group = MonitorGroup(bus, grouped, arms) if grouped is not None else None
         watched = group.discover() if group is not None else arms
         node = MonitorNode(bus, runtime, watched, require_truth=bool(cfg.require_truth),
@@ -173,22 +173,15 @@ def _say_group(group: Any, node: Any) -> None:
           f"{', '.join(members)}", flush=True)  # fmt: skip
 
 
-SETTLE_S = 0.5  # after the writers matched, for the readers to match them back
-
-
 def wait_for_subscribers(writers: list[Any], timeout_s: float) -> bool:
     """Until every writer has matched a reader (on a secured graph: its keys exchanged), at
     most ``timeout_s``: what is written before a reader matches never reaches it. Whether all
-    did. Then :data:`SETTLE_S` more: a writer matches a reader before the reader has matched it
-    back, and a reader that has not yet gets the first samples late, after newer ones (Cyclone
-    catching up a late-matched writer; once in the suite, eight ``fault_state`` samples "went
-    backwards" at a monitor stopped 0.3 s in every 1.2 s)."""
+    did."""
     from robohealth_mj.ros2.bus import Bus
 
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         if all(Bus.matched_readers(w) for w in writers):
-            time.sleep(SETTLE_S)
             return True
         time.sleep(0.05)
     return False
@@ -201,7 +194,7 @@ def run_robot(cfg: DictConfig, stream: Iterator[tuple[float, GraphSample]]) -> i
     from robohealth_mj.ros2.bus import Bus
     from robohealth_mj.ros2.node import ArmPublisher
 
-    with Bus(bus_config(cfg.ros2)) as bus:  # deleted on a refusal too, not left to the exit
+    with Bus(bus_config(cfg.ros2)) as bus:  # deleted at once on a refusal, not left to the exit
         arms = [ArmPublisher(bus, arm, **layout_options(cfg.ros2)) for arm in arm_names(cfg.ros2)]
         wait_for_subscribers([w for arm in arms for w in arm.writers.values()],
                              float(cfg.discovery_s))  # fmt: skip

@@ -289,9 +289,10 @@ def test_simulated_arms_on_loopback_are_diagnosed_and_reported_on_diagnostics(de
         bus.close()
 
 
-def test_a_closed_bus_leaves_the_domain_even_while_its_reader_is_still_held():
-    """A refusal's traceback holds the bus's entities; closing must still delete the
-    participant then, not at the interpreter's exit (where it raced the security plugins)."""
+def test_a_bus_left_on_an_error_leaves_the_domain_even_while_its_reader_is_still_held():
+    """A refusal's traceback holds the bus's entities; leaving the bus on an error must still
+    delete the participant then, not at the interpreter's exit (where it raced the security
+    plugins)."""
     from robohealth_mj.ros2.idl import JointState
 
     config = _bus()
@@ -302,8 +303,8 @@ def test_a_closed_bus_leaves_the_domain_even_while_its_reader_is_still_held():
     while time.monotonic() < deadline and not Bus.matched_readers(writer):
         time.sleep(0.05)
     assert Bus.matched_readers(writer) == 1
-    with monitor:
-        pass
+    with pytest.raises(ValueError), monitor:
+        raise ValueError("a refusal")
     while time.monotonic() < deadline + 10 and Bus.matched_readers(writer):
         time.sleep(0.05)
     assert Bus.matched_readers(writer) == 0 and held is not None
