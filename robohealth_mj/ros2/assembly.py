@@ -75,7 +75,10 @@ class ArmAssembler:
         aggregated: str | None = None,
         sensors: bool = True,
         joints: Sequence[str] = JOINT_NAMES,
+        history: int = 10,
     ) -> None:
+        """``history``: the bus's history depth, how many ticks back a reliable writer can still
+        re-deliver (Cyclone re-sends a late-matched reader's first samples after newer ones)."""
         self.arm, self.topics, self.aggregated = arm, topics, aggregated
         self.joints = tuple(joints)  # what this arm's JointState messages call its joints
         self.require_truth, self.late_ticks, self.sensors = require_truth, late_ticks, sensors
@@ -105,9 +108,9 @@ class ArmAssembler:
         self.queues: dict[str, deque] = {t: deque() for t in self.vibration}
         self.last_emitted: int | None = None
         # the messages of the last settled (emitted or missed) ticks, to tell a duplicate or a
-        # late message from a stamp that went backwards
+        # late message from a stamp that went backwards: as far back as a writer re-delivers
         self.settled: dict[int, dict[str, Any]] = {}
-        self.settled_kept = max(4 * late_ticks, 32)
+        self.settled_kept = max(4 * late_ticks, 32, history)
         self.count = 0
 
     def topic_names(self) -> list[str]:

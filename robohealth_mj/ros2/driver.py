@@ -99,10 +99,12 @@ class DriverAssembler:
         joints: Sequence[str],
         config: DriverConfig | None = None,
         max_age_s: float = 0.1,
+        history: int = 10,
     ) -> None:
         """``joint_states`` and ``controller_state``: the arm's topic names; ``joints``: the
         names its driver gives its joints, base to tool (any ros2_control arm: a UR's six, an
-        FR3's seven)."""
+        FR3's seven). ``history``: the bus's history depth, how many messages back a reliable
+        writer can still re-deliver."""
         config = config or DriverConfig()
         self.arm, self.joint_states, self.controller_state = arm, joint_states, controller_state
         self.joints, self.tracking = tuple(joints), config.tracking
@@ -121,6 +123,9 @@ class DriverAssembler:
         self.pending: deque[tuple[int, np.ndarray]] = deque()  # ticks waiting for the controller
         self.errors: deque[tuple[int, np.ndarray]] = deque(maxlen=256)  # (stamp, pos_error [J])
         self.last_error: tuple[int, Any] | None = None
+        # each topic's last ``history`` messages by stamp: a re-delivery of any is a duplicate
+        self.recent: dict[str, dict[int, Any]] = {joint_states: {}, controller_state: {}}
+        self.history = max(history, 1)
         self.silent = False  # the controller is reported silent until its state returns
 
     def topic_names(self) -> list[str]:
@@ -135,8 +140,9 @@ class DriverAssembler:
             return out
         last = self.last_state if topic == self.joint_states else self.last_error
         if last is not None and stamp <= last[0]:
-            self._not_after(topic, stamp, msg == last[1], last[0], out)
+            self._not_after(topic, stamp, msg, last[0], out)
             return out
+        self._remember(topic, stamp, msg)
         try:
             if topic == self.joint_states:
                 self.last_state = (stamp, msg)
@@ -165,8 +171,9 @@ class DriverAssembler:
                 continue
             last = self.last_state if joint_states else self.last_error
             if last is not None and stamp <= last[0]:
-                self._not_after(topic, stamp, buf == last[1], last[0], out)
+                self._not_after(topic, stamp, buf, last[0], out)
                 continue
+            self._remember(topic, stamp, buf)
             if not joint_states:
                 self.last_error = (stamp, buf)
                 self.errors.append((stamp, (kind, buf)))  # decoded when a tick takes it
@@ -183,9 +190,16 @@ class DriverAssembler:
                     out.problems.append(f"topic '{topic}': {undecodable(kind, exc)}")
             self._drain(out, settle=False)
 
-    def _not_after(self, topic: str, stamp: int, same: bool, last: int, out: Assembled) -> None:
-        """A message not newer than the topic's last: a re-delivery, or stamps going back."""
-        if stamp == last and same:
+    def _remember(self, topic: str, stamp: int, msg: Any) -> None:
+        recent = self.recent[topic]
+        recent[stamp] = msg
+        if len(recent) > self.history:  # stamps arrive rising: the first key is the oldest
+            del recent[next(iter(recent))]
+
+    def _not_after(self, topic: str, stamp: int, msg: Any, last: int, out: Assembled) -> None:
+        """A message not newer than the topic's last: a re-delivery of one of its recent
+        messages, or stamps going back."""
+        if stamp in self.recent[topic] and self.recent[topic][stamp] == msg:
             out.duplicates += 1
         else:
             out.problems.append(

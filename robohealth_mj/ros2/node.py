@@ -255,12 +255,13 @@ class MonitorNode:
         joints = arm_joint_names(o["joint_names"], o["tf_prefix"].format(arm=arm))
         kinds = arm_kinds(names, arm, o["layout"], o["driver"], o["namespace"])
         if o["layout"] == "ur_driver":
-            assembler = DriverAssembler(arm, *kinds, joints, o["driver"] or DriverConfig())
+            assembler = DriverAssembler(arm, *kinds, joints, o["driver"] or DriverConfig(),
+                                        history=self.bus.config.depth)  # fmt: skip
         else:
             aggregated = names.aggregated if o["layout"] == "aggregated" else None
             assembler = ArmAssembler(arm, names, require_truth=o["require_truth"],
                                      aggregated=aggregated, sensors=o["layout"] != "joints",
-                                     joints=joints)  # fmt: skip
+                                     joints=joints, history=self.bus.config.depth)  # fmt: skip
         # every assembler reads the bytes: the bag layouts' by byte templates, the driver's
         # decoding only the messages a tick uses
         readers = [(t, kinds[t], self.bus.reader(t, kinds[t])) for t in assembler.topic_names()]

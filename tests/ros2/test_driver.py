@@ -281,6 +281,12 @@ def test_bad_driver_messages_are_one_line_naming_topic_and_field_and_repeats_are
                         "not 6"]  # fmt: skip
     back = assembler.add("/js", messages.messages(samples[1])[0])  # older than the newest
     assert back.problems[0].endswith("stamps went backwards")
+    again = assembler.add("/js", js)  # the first message re-delivered after three newer ones
+    assert again.duplicates == 1 and again.problems == []
+    forgetful = DriverAssembler("left", "/js", "/cs", UR, DriverConfig(tracking=False), history=2)
+    for m in (js, *(messages.messages(s)[0] for s in samples[1:])):
+        forgetful.add("/js", m)
+    assert forgetful.add("/js", js).problems[0].endswith("stamps went backwards")  # past depth
 
 
 def _bus(**kw) -> BusConfig:
