@@ -127,11 +127,14 @@ def prepare(cfg: DictConfig) -> Prepared:
     device = pick_device(cfg.trainer.device)
     graph: GraphSpec = instantiate(cfg.graph)  # a bad config value is named before any data
     sensing = instantiate(cfg.sensing)
-    if cfg.model.get("coupling_fit") == "motion" and cfg.trainer.get("placements"):
+    fit = cfg.model.get("coupling_fit")
+    if fit in ("motion", "given") and cfg.trainer.get("placements"):
         raise InputError(
-            "model.coupling_fit=motion fits one placement from the data; trainer.placements "
-            "gives each window its own: choose one"
+            f"model.coupling_fit={fit} sets one placement; trainer.placements gives each window "
+            "its own: choose one"
         )
+    if fit == "given" and graph.coupling is None:
+        raise InputError("model.coupling_fit=given needs graph=harness (a placement to give)")
     files = expand_paths(cfg.data.train)
     check_transfer(cfg, files)
     rec = load_recordings(files, pad=bool(cfg.get("transfer", False)))  # across joint counts
@@ -148,6 +151,8 @@ def prepare(cfg: DictConfig) -> Prepared:
     head = getattr(model, "anomaly", None)
     if head is not None and head.coupling_fit == "motion":
         head.set_coupling(training_placement(rec, splits["train"], graph))  # frozen from here
+    elif head is not None and head.coupling_fit == "given":  # a study's ceiling: the truth
+        head.set_coupling(graph.coupling)
     pool = None
     if cfg.trainer.get("placements"):
         pool = placement_pool(

@@ -85,7 +85,9 @@ class AnomalyResidualHead(nn.Module):
     estimator commissioning uses): each entry a non-negative least-squares weight of how much
     of a joint's motion-predicted emission a sensor carries. It stays frozen, so no loss can
     move it, and with energy scores (``>= 0``) a sensor's deviation can only raise the logits of
-    the joints it carries. ``coupling_fit="losses"`` (the thesis): every loss trains ``C``.
+    the joints it carries. ``coupling_fit="given"``: the graph's true placement, set and frozen
+    the same way; a study's ceiling (the same sensors with the placement known), not something a
+    user has. ``coupling_fit="losses"`` (the thesis): every loss trains ``C``.
 
     ``joint_scores`` adds a per-joint score ``v(h_j)`` from each joint's own embedding. Told a
     placement (a pool model), the scattered scores alone are a fixed function of the sensors'
@@ -94,7 +96,7 @@ class AnomalyResidualHead(nn.Module):
     """
 
     SCORES = ("signed", "energy")
-    FITS = ("losses", "motion")
+    FITS = ("losses", "motion", "given")
 
     def __init__(
         self,

@@ -297,21 +297,24 @@ def test_a_commissioned_self_calibrating_model_streams_as_it_scores_windows(
 def test_training_with_the_motion_fit_sets_the_placement_once_and_never_moves_it(
     tiny_corpus, tmp_path
 ):
-    """``model.coupling_fit=motion`` (issue 69): the trained model's C is the motion estimate on
-    the healthy running its training windows cover, set before the first step and unchanged by
-    training; it reads the drawn placement with the right sign (its correlation is positive and
-    recorded with the run)."""
+    """``+experiment=unknown_placement`` (issue 69): the trained model's C is the motion
+    estimate on the healthy running its training windows cover, set before the first step and
+    unchanged by training, and reaches the joint scores and the edges; it reads the drawn
+    placement with the right sign (its correlation is positive and recorded with the run)."""
     from robohealth_mj.learn.motion_placement import training_placement
     from robohealth_mj.learn.trainer import prepare
 
     cfg = compose_config("train", [
         f"data.train=[{tiny_corpus}/train_*]", f"data.evaluate.heldout={tiny_corpus}/heldout",
-        "data.evaluate.probe=null", "trainer.progress=false", "graph=harness",
+        "data.evaluate.probe=null", "trainer.progress=false", "+experiment=unknown_placement",
         "graph.coupling_seed=3", "window=8", "variant=anomaly_residual", "model.hidden=8",
-        "model.coupling_fit=motion", "model.anomaly_scores=energy", "trainer.epochs=2",
+        "trainer.epochs=2",
     ])  # fmt: skip
     results = run(cfg, tmp_path)
-    trained = build(load_checkpoint(tmp_path / "best.ckpt")).anomaly.coupling().detach().numpy()
+    ckpt = load_checkpoint(tmp_path / "best.ckpt")
+    assert ckpt["model_cfg"]["coupling_fit"] == "motion"
+    assert ckpt["model_cfg"]["anomaly_joint_scores"] and ckpt["model_cfg"]["coupled_edges"]
+    trained = build(ckpt).anomaly.coupling().detach().numpy()
     p = prepare(cfg)
     fitted = training_placement(p.rec, p.splits["train"], p.graph)
     np.testing.assert_allclose(trained, np.maximum(fitted, 1e-2), rtol=1e-4, atol=1e-5)
@@ -319,6 +322,29 @@ def test_training_with_the_motion_fit_sets_the_placement_once_and_never_moves_it
     corr = coupling_correlation(trained, truth)
     assert corr > 0.5
     assert results["train"]["coupling_correlation"] == pytest.approx(corr, abs=1e-4)
+
+
+def test_a_given_placement_is_the_truth_frozen_and_needs_a_harness(tiny_corpus, tmp_path):
+    """``model.coupling_fit=given`` (a study's ceiling: the same sensors with the placement
+    known): the trained C is the graph's true placement, untouched by training; a graph without
+    a placement is one line before any data."""
+    from robohealth_mj.learn.trainer import prepare
+
+    cfg = compose_config("train", [
+        f"data.train=[{tiny_corpus}/train_*]", f"data.evaluate.heldout={tiny_corpus}/heldout",
+        "data.evaluate.probe=null", "trainer.progress=false", "+experiment=unknown_placement",
+        "graph.coupling_seed=3", "window=8", "model.hidden=8", "trainer.epochs=1",
+        "model.coupling_fit=given",
+    ])  # fmt: skip
+    run(cfg, tmp_path)
+    trained = build(load_checkpoint(tmp_path / "best.ckpt")).anomaly.coupling().detach().numpy()
+    truth = harness_graph(coupling_seed=3).coupling
+    np.testing.assert_allclose(trained, np.maximum(truth, 1e-2), rtol=1e-4, atol=1e-5)
+    structural = compose_config("train", [
+        "data.train=[/nonexistent/train_*]", "model.coupling_fit=given",
+    ])  # fmt: skip
+    with pytest.raises(ValueError, match=r"^model.coupling_fit=given needs graph=harness"):
+        prepare(structural)
 
 
 def test_a_motion_fit_under_drawn_placements_is_refused_before_any_data():
