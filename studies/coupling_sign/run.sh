@@ -15,6 +15,12 @@
 # C0 full and placement 1 retrofit (seed 42).
 # joint_more: the same form on C0 at seeds 43 and 44 (full) and 42-44 (retrofit), on placements 3
 # and 5 (full) and on placement 2 (retrofit), seed 42 where not said.
+# epochs: the C0 retrofit runs (motion fit; FORMS: motion, motion_joint (joint scores),
+# motion_joint_coupled (and the joint-sensor edges set by C)) at EPOCHS; known: the known
+# placement's (structural graph, the thesis's recipe) at EPOCHS, the ceiling to compare with;
+# coupled: the form chosen there (joint scores, coupled edges, 40 epochs) on C0 full, seeds
+# 42-44, and on placements 1 and 2 full, seed 42; given: that form told the true placement
+# (C0 retrofit, 42-44), the ceiling on the same four sensors.
 # grid: that recipe and gbdt on all ten placements (placement_fits.py's), GRID_PROFILES (default
 # both) at GRID_SEEDS (default 42); archive: the finished runs' records into results/runs
 # (committed); grid_table: results/grid.md from that archive.
@@ -27,9 +33,10 @@ CORPUS=${CORPUS:-outputs/corpus/standard}
 HERE=studies/coupling_sign
 
 run() {  # out_dir, then overrides: one training run of one thread
-  local out=$1 scores=(model.anomaly_scores=energy); shift
-  [[ " $* " == *" variant=gbdt "* ]] && scores=()  # the trees have no anomaly scores
-  $PY -m robohealth_mj.train graph=harness window=32 "${scores[@]}" \
+  local out=$1 base=(graph=harness model.anomaly_scores=energy); shift
+  [[ " $* " == *" variant=gbdt "* ]] && base=(graph=harness)  # the trees have no anomaly scores
+  [[ " $* " == *" graph="* ]] && base=()  # another graph: the thesis's recipe for it
+  $PY -m robohealth_mj.train window=32 "${base[@]}" \
     threads=1 trainer.progress=false "data.train=[$CORPUS/train_*]" \
     data.evaluate.heldout="$CORPUS/heldout_seed900" '~data.evaluate.probe' \
     out_dir="$ROOT/$out" "$@" >"$ROOT/logs/${out//\//_}.log" 2>&1 || echo "failed: $out" >&2
@@ -80,6 +87,16 @@ for part in "$@"; do
                seed3_m6:full:3:6:42 seed5_m4:full:5:4:42 seed2_m4:retrofit:2:4:42; do
         joint_line "$p"
       done | parallel_runs ;;
+    epochs)  # C0 retrofit, motion fit, FORMS trained for EPOCHS (default 40; patience 8), 42-44
+      e=${EPOCHS:-40}
+      for seed in 42 43 44; do for form in ${FORMS:-motion motion_joint}; do
+        extra=""
+        [[ $form == *joint* ]] && extra+=" model.anomaly_joint_scores=true"
+        [[ $form == *coupled* ]] && extra+=" model.coupled_edges=true"
+        echo "default/retrofit/C0/anomaly_residual_${form}_e$e/seed$seed variant=anomaly_residual" \
+          "sensing=retrofit seed=$seed model.coupling_fit=motion trainer.epochs=$e" \
+          "trainer.patience=8$extra"
+      done; done | parallel_runs ;;
     grid)
       fits="import sys; sys.path.insert(0, '$HERE'); import placement_fits as f"
       places=$($PY -c "$fits; print(f.PLACEMENTS)")  # the placements the fits cover
@@ -89,10 +106,43 @@ for part in "$@"; do
         echo "placements/$s/seed${p%:*}_m${p#*:}/gbdt/seed$seed variant=gbdt sensing=$s" \
           "seed=$seed graph.coupling_seed=${p%:*} graph.coupling_sensors=${p#*:}"
       done; done; done | parallel_runs ;;
+    coupled)  # the chosen form on C0 full (42-44) and on sparse placements 1 and 2 (full, 42)
+      form="model.coupling_fit=motion model.anomaly_joint_scores=true model.coupled_edges=true"
+      form+=" trainer.epochs=40 trainer.patience=8"
+      {
+        for seed in 42 43 44; do
+          echo "default/full/C0/anomaly_residual_motion_joint_coupled_e40/seed$seed" \
+            "variant=anomaly_residual sensing=full seed=$seed $form"
+        done
+        for p in 1:3 2:4; do
+          place=placements/full/seed${p%:*}_m${p#*:}
+          echo "$place/anomaly_residual_motion_joint_coupled_e40/seed42 variant=anomaly_residual" \
+            "sensing=full seed=42 $form graph.coupling_seed=${p%:*}" \
+            "graph.coupling_sensors=${p#*:}"
+        done
+      } | parallel_runs ;;
+    given)  # the chosen form told the true placement (frozen): the same sensors, C known
+      for seed in 42 43 44; do
+        echo "default/retrofit/C0/anomaly_residual_given_joint_coupled_e40/seed$seed" \
+          "variant=anomaly_residual sensing=retrofit seed=$seed model.coupling_fit=given" \
+          "model.anomaly_joint_scores=true model.coupled_edges=true trainer.epochs=40" \
+          "trainer.patience=8"
+      done | parallel_runs ;;
+    known)  # the known placement (structural graph), retrofit, EPOCHS (default 40), 42-44
+      e=${EPOCHS:-40}
+      for seed in 42 43 44; do
+        echo "default/retrofit/C0/known_anomaly_residual_e$e/seed$seed variant=anomaly_residual" \
+          "sensing=retrofit seed=$seed graph=structural trainer.epochs=$e trainer.patience=8"
+      done | parallel_runs ;;
     archive)  # each finished run's summary and held-out figures, nothing heavier
       for f in "$ROOT"/placements/*/*/*/seed*/{train_summary,eval_heldout}.json; do
         [ -f "$f" ] || continue
         dest=$HERE/results/runs/${f#"$ROOT"/placements/}
+        mkdir -p "$(dirname "$dest")" && cp "$f" "$dest"
+      done
+      for f in "$ROOT"/default/*/C0/*/seed*/{train_summary,eval_heldout}.json; do
+        [ -f "$f" ] || continue
+        dest=$HERE/results/runs/${f#"$ROOT"/}
         mkdir -p "$(dirname "$dest")" && cp "$f" "$dest"
       done ;;
     grid_table) $PY $HERE/summarise.py --grid $HERE/results/grid.md ;;

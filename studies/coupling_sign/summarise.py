@@ -1,6 +1,7 @@
 """The tables of ``studies/coupling_sign/results/results.md`` from the runs (issue 69).
 
     python studies/coupling_sign/summarise.py [--root outputs/coupling_sign] [--out FILE]
+    python studies/coupling_sign/summarise.py --grid FILE | --epochs FILE   (from results/runs)
 
 Reads this study's runs (``run.sh``: the motion-fitted coupling, ``model.coupling_fit=motion``),
 the thesis rerun's committed runs of the same recipe with the coupling every loss trains
@@ -177,6 +178,63 @@ HEADER = (
 )
 
 
+EPOCHS_HEADER = (
+    "# Retrofit on C0, trained longer (issue 69)\n\n"
+    "Made by `bash studies/coupling_sign/run.sh epochs archive` (`FORMS=motion_joint_coupled` "
+    "at `EPOCHS=40` and `20` for the coupled rows; `known` for the known-placement rows), then "
+    "`python studies/coupling_sign/summarise.py --epochs FILE`, from the committed run records "
+    "(`results/runs/default`). C0, retrofit sensing, W = 32, energy scores, the motion-fitted C "
+    "frozen; seeds 42-44; 40-epoch runs with patience 8 (20-epoch ones: 6, the coupled 8). "
+    "Validation figures are the best epoch's (what selection saw). The known-placement rows are "
+    "the structural graph (each sensor's joint given), the ceiling the issue measures against."
+)
+EPOCH_ROWS = (  # (row name, run folder under results/runs/default/retrofit/C0)
+    ("motion + joint scores, 20 epochs", "anomaly_residual_motion_joint"),
+    ("motion, 40 epochs", "anomaly_residual_motion_e40"),
+    ("motion + joint scores, 40 epochs", "anomaly_residual_motion_joint_e40"),
+    ("motion + joint scores + coupled edges, 20 ep.", "anomaly_residual_motion_joint_coupled_e20"),
+    ("motion + joint scores + coupled edges, 40 ep.", "anomaly_residual_motion_joint_coupled_e40"),
+    ("known placement (structural), 40 epochs", "known_anomaly_residual_e40"),
+)
+
+
+def epochs_section(archive: Path) -> list[str]:
+    """The C0 retrofit forms and training lengths beside ``gbdt`` and the known placement (the
+    thesis rerun's 20-epoch rows: seed 42 alone)."""
+    c0 = archive / "default" / "retrofit" / "C0"
+    structural = THESIS.parent / "structural"
+    rows = [("gbdt (harness)", runs_of("retrofit/C0/gbdt/w32/seed*", THESIS))]
+    rows += [(name, runs_of(f"{folder}/seed*", c0)) for name, folder in EPOCH_ROWS]
+    rows += [
+        ("known placement: gbdt (structural)", runs_of("retrofit/C0/gbdt/w32/seed*", structural)),
+        ("known placement (structural), 20 epochs",
+         runs_of("retrofit/C0/anomaly_residual/w32/seed*", structural)),
+    ]  # fmt: skip
+    return table(rows)
+
+
+CHOSEN = "anomaly_residual_motion_joint_coupled_e40"
+
+
+def chosen_elsewhere(archive: Path) -> list[str]:
+    """The chosen form on the full profile: C0 (three seeds) and two sparse placements (seed
+    42), beside the 20-epoch recipe without coupled edges and ``gbdt``."""
+    c0 = archive / "default" / "full" / "C0"
+    rows = [
+        ("C0 gbdt", runs_of("full/C0/gbdt/w32/seed*", THESIS)),
+        ("C0 motion + joint scores, 20 epochs", runs_of(f"{RECIPE}/seed*", c0)),
+        ("C0 + coupled edges, 40 epochs", runs_of(f"{CHOSEN}/seed*", c0)),
+    ]
+    for place in ("seed1_m3", "seed2_m4"):
+        where = archive / "full" / place
+        rows += [
+            (f"{place} gbdt", runs_of("gbdt/seed42", where)),
+            (f"{place} motion + joint scores, 20 epochs", runs_of(f"{RECIPE}/seed42", where)),
+            (f"{place} + coupled edges, 40 epochs", runs_of(f"{CHOSEN}/seed42", where)),
+        ]
+    return table(rows)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--root", type=Path, default=Path("outputs/coupling_sign"))
@@ -185,7 +243,17 @@ def main() -> None:
         "--grid", type=Path, metavar="FILE",
         help="instead: write the ten-placement grid's table from the committed run archive",
     )  # fmt: skip
+    parser.add_argument(
+        "--epochs", type=Path, metavar="FILE",
+        help="instead: write the C0 retrofit training-length table from the committed archive",
+    )  # fmt: skip
     args = parser.parse_args()
+    if args.epochs:
+        lines = [EPOCHS_HEADER, "", *epochs_section(ARCHIVE), "", "## The chosen form on the "
+                 "full profile", "", *chosen_elsewhere(ARCHIVE)]  # fmt: skip
+        atomic_write_text(args.epochs, "\n".join(lines))
+        print(f"wrote {args.epochs}")
+        return
     if args.grid:
         atomic_write_text(args.grid, "\n".join([GRID_HEADER, "", *grid_section(ARCHIVE)]))
         print(f"wrote {args.grid}")
