@@ -181,15 +181,22 @@ def test_the_fit_drops_joints_that_barely_explain_a_sensor_and_keeps_the_ones_th
     np.testing.assert_allclose(pruned[[1, 4]], [1.0, 0.5], atol=0.03)
 
 
+def _tiny_training(corpus: Path, overrides: list[str]):
+    """The train config on the tiny corpus, quiet, without the probe session."""
+    return compose_config("train", [
+        f"data.train=[{corpus}/train_*]", f"data.evaluate.heldout={corpus}/heldout",
+        "data.evaluate.probe=null", "trainer.progress=false", *overrides,
+    ])  # fmt: skip
+
+
 @pytest.fixture(scope="module")
 def drawn(tiny_corpus, tmp_path_factory) -> dict:
     """A barely trained self-calibrating model (``+experiment=self_calibrating``: the placement
     told to edges, sensors and head, given as a fit finds it) under four drawn placements
     (harness, W = 8)."""
     root = tmp_path_factory.mktemp("drawn")
-    cfg = compose_config("train", [
-        f"data.train=[{tiny_corpus}/train_*]", f"data.evaluate.heldout={tiny_corpus}/heldout",
-        "data.evaluate.probe=null", "trainer.progress=false", "+experiment=self_calibrating",
+    cfg = _tiny_training(tiny_corpus, [
+        "+experiment=self_calibrating",
         "window=8", "model.hidden=8", "trainer.epochs=1", "trainer.placements=4",
         "trainer.placement_noise=0.3",
     ])  # fmt: skip
@@ -304,9 +311,8 @@ def test_training_with_the_motion_fit_sets_the_placement_once_and_never_moves_it
     from robohealth_mj.learn.motion_placement import training_placement
     from robohealth_mj.learn.trainer import prepare
 
-    cfg = compose_config("train", [
-        f"data.train=[{tiny_corpus}/train_*]", f"data.evaluate.heldout={tiny_corpus}/heldout",
-        "data.evaluate.probe=null", "trainer.progress=false", "+experiment=unknown_placement",
+    cfg = _tiny_training(tiny_corpus, [
+        "+experiment=unknown_placement",
         "graph.coupling_seed=3", "window=8", "variant=anomaly_residual", "model.hidden=8",
         "trainer.epochs=2",
     ])  # fmt: skip
@@ -330,9 +336,8 @@ def test_a_given_placement_is_the_truth_frozen_and_needs_a_harness(tiny_corpus, 
     a placement is one line before any data."""
     from robohealth_mj.learn.trainer import prepare
 
-    cfg = compose_config("train", [
-        f"data.train=[{tiny_corpus}/train_*]", f"data.evaluate.heldout={tiny_corpus}/heldout",
-        "data.evaluate.probe=null", "trainer.progress=false", "+experiment=unknown_placement",
+    cfg = _tiny_training(tiny_corpus, [
+        "+experiment=unknown_placement",
         "graph.coupling_seed=3", "window=8", "model.hidden=8", "trainer.epochs=1",
         "model.coupling_fit=given",
     ])  # fmt: skip
