@@ -63,8 +63,9 @@ class TrendRul:
         """From a joint's sessions so far (``days [S]``, ``index [S]``, oldest first)."""
         d, h = np.asarray(days, float), np.asarray(index, float)
         last = float(h[np.isfinite(h)][-1]) if np.isfinite(h).any() else math.nan
-        if self.since is not None:
-            start = int(np.argmax(h >= self.since)) if (h >= self.since).any() else len(h)
+        if self.since is not None:  # from the first session that reached it (none: no fit)
+            reached = np.flatnonzero(h >= self.since)
+            start = int(reached[0]) if len(reached) else len(h)
             d, h = d[start:], h[start:]
         d, h = d[-self.window :], h[-self.window :]
         keep = np.isfinite(h)

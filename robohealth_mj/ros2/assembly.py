@@ -63,6 +63,14 @@ class _Problem(Exception):
     pass
 
 
+def keep_recent(store: dict[int, Any], stamp: int, value: Any, kept: int) -> None:
+    """Remember ``value`` at ``stamp`` among the last ``kept`` (stamps come rising, so the
+    first key is the oldest): how far back a re-delivery is still told from bad input."""
+    store[stamp] = value
+    if len(store) > kept:
+        del store[next(iter(store))]
+
+
 class ArmAssembler:
     """Assembles one arm's samples; ``topics`` are that arm's (namespaced) topic names."""
 
@@ -210,9 +218,7 @@ class ArmAssembler:
     def _settle(self, stamp: int, slot: dict[str, Any]) -> None:
         del self.pending[stamp]
         self.last_emitted = stamp
-        self.settled[stamp] = slot  # stamps settle in rising order: the first key is the oldest
-        if len(self.settled) > self.settled_kept:
-            del self.settled[next(iter(self.settled))]
+        keep_recent(self.settled, stamp, slot, self.settled_kept)
 
     def _stamped_in(self, slot: dict[str, Any]) -> bool:
         return self._stamped_set <= slot.keys()

@@ -36,7 +36,7 @@ import numpy as np
 from robohealth_mj.bags.joints import joint_order
 from robohealth_mj.common.errors import InputError
 from robohealth_mj.data.jsonl import node_features
-from robohealth_mj.ros2.assembly import Assembled, header_stamp_ns
+from robohealth_mj.ros2.assembly import Assembled, header_stamp_ns, keep_recent
 from robohealth_mj.ros2.cdr import decode, stamp_ns_at, undecodable
 from robohealth_mj.schema import (
     SENSOR_FEATURES,
@@ -142,7 +142,7 @@ class DriverAssembler:
         if last is not None and stamp <= last[0]:
             self._not_after(topic, stamp, msg, last[0], out)
             return out
-        self._remember(topic, stamp, msg)
+        keep_recent(self.recent[topic], stamp, msg, self.history)
         try:
             if topic == self.joint_states:
                 self.last_state = (stamp, msg)
@@ -173,7 +173,7 @@ class DriverAssembler:
             if last is not None and stamp <= last[0]:
                 self._not_after(topic, stamp, buf, last[0], out)
                 continue
-            self._remember(topic, stamp, buf)
+            keep_recent(self.recent[topic], stamp, buf, self.history)
             if not joint_states:
                 self.last_error = (stamp, buf)
                 self.errors.append((stamp, (kind, buf)))  # decoded when a tick takes it
@@ -189,12 +189,6 @@ class DriverAssembler:
                 except Exception as exc:  # bytes no decoder reads: this arm's bad input
                     out.problems.append(f"topic '{topic}': {undecodable(kind, exc)}")
             self._drain(out, settle=False)
-
-    def _remember(self, topic: str, stamp: int, msg: Any) -> None:
-        recent = self.recent[topic]
-        recent[stamp] = msg
-        if len(recent) > self.history:  # stamps arrive rising: the first key is the oldest
-            del recent[next(iter(recent))]
 
     def _not_after(self, topic: str, stamp: int, msg: Any, last: int, out: Assembled) -> None:
         """A message not newer than the topic's last: a re-delivery of one of its recent

@@ -107,8 +107,7 @@ for part in "$@"; do
           "seed=$seed graph.coupling_seed=${p%:*} graph.coupling_sensors=${p#*:}"
       done; done; done | parallel_runs ;;
     coupled)  # the chosen form on C0 full (42-44) and on sparse placements 1 and 2 (full, 42)
-      form="model.coupling_fit=motion model.anomaly_joint_scores=true model.coupled_edges=true"
-      form+=" trainer.epochs=40 trainer.patience=8"
+      form=+experiment=unknown_placement  # the motion fit, joint scores, C as edges, 40 epochs
       {
         for seed in 42 43 44; do
           echo "default/full/C0/anomaly_residual_motion_joint_coupled_e40/seed$seed" \
@@ -124,9 +123,8 @@ for part in "$@"; do
     given)  # the chosen form told the true placement (frozen): the same sensors, C known
       for seed in 42 43 44; do
         echo "default/retrofit/C0/anomaly_residual_given_joint_coupled_e40/seed$seed" \
-          "variant=anomaly_residual sensing=retrofit seed=$seed model.coupling_fit=given" \
-          "model.anomaly_joint_scores=true model.coupled_edges=true trainer.epochs=40" \
-          "trainer.patience=8"
+          "variant=anomaly_residual sensing=retrofit seed=$seed +experiment=unknown_placement" \
+          "model.coupling_fit=given"
       done | parallel_runs ;;
     known)  # the known placement (structural graph), retrofit, EPOCHS (default 40), 42-44
       e=${EPOCHS:-40}
