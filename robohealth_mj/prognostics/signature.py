@@ -28,6 +28,7 @@ No window model is needed. NumPy only.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -61,6 +62,13 @@ DETECT = 16.0
 # arm's weight fit a day alike (both sag by one offset under a one-sided torque): the last days'
 # loads settle those calls (LOAD_DAYS below).
 MARGIN = 20.0
+# How far one channel may pull a severity read: a channel's squared misfit (in expected scatters)
+# counts at most this much, so a channel whose days at one joint stray from the episodes' shape
+# (a softer drive's gap at the first wrist: -12 spreads where the response says +1) adds a fixed
+# penalty instead of dragging the read to the grid's end (1.5 at a truth of 0.41). Chosen on the
+# validation lives (studies/wear/README.md, the fifth pass); the call's likelihood keeps every
+# channel's whole misfit (limited there too, validation read worse).
+OUTLIER = 25.0
 # A gap and a softer spring make a joint that carries the arm's weight sag by one offset within a
 # day: its torque keeps its sign and varies mostly by the motor's friction, which the spring never
 # feels (studies/wear/results/load_dependence.md). From day to day the payload changes the load: a
@@ -81,7 +89,8 @@ class Signatures:
     [M, C]``: the channels a mode is read from (modes in :data:`MECHANICAL_CLASSES` order; C over
     :data:`CHANNELS`, the speed's and load's rows unused); ``detect``, ``margin``: see
     :func:`adapt`; ``error [M, C]``: how far a day's excess strays from the response, as a share
-    of it (None: not at all; see :func:`adapt`)."""
+    of it (None: not at all; see :func:`adapt`); ``outlier``: the most one channel's squared
+    misfit counts in a severity read (:data:`OUTLIER`; infinite: no limit)."""
 
     baseline: np.ndarray
     spread: np.ndarray
@@ -90,6 +99,7 @@ class Signatures:
     detect: float = 0.0
     margin: float = 0.0
     error: np.ndarray | None = None
+    outlier: float = math.inf
 
     def excess(self, readings: np.ndarray) -> np.ndarray:
         """``[C, J]`` each reading above its healthy level at the day's speed, in spreads (NaN
@@ -115,11 +125,12 @@ class Signatures:
         :meth:`_grid`: per mode and grid severity the squared misfit over the mode's channels,
         each in units of its expected scatter, the misfit of no wear, whether any channel was
         read, and the predicted excess's size over the channels read, in healthy spreads (how far
-        a healthy day's noise can move the read)."""
+        a healthy day's noise can move the read). Each channel's term counts at most
+        :attr:`outlier`."""
         z, predicted, scatter = grid
         read = np.isfinite(z)[None] & self.use[:, :, None]  # [M, C, J]
         miss = np.where(read[:, None], np.nan_to_num(z) - predicted, 0.0) ** 2 / scatter
-        cost = miss.sum(axis=2)
+        cost = np.minimum(miss, self.outlier).sum(axis=2)
         known = np.isfinite(self.response).all(axis=(1, 3))  # [M, J]: the pairs fitted
         size = np.sqrt((np.where(read[:, None], predicted, 0.0) ** 2).sum(axis=2))  # [M, S, J]
         cost = np.where(known[:, None], cost, np.inf)
@@ -233,6 +244,7 @@ class Signatures:
             "detect": self.detect,
             "margin": self.margin,
             "error": None if self.error is None else np.round(self.error, 12).tolist(),
+            "outlier": None if math.isinf(self.outlier) else self.outlier,
         }
 
     @classmethod
@@ -243,8 +255,12 @@ class Signatures:
             channels = list(data["channels"])
             detect, margin = float(data["detect"]), float(data["margin"])
             error = None if data["error"] is None else np.asarray(data["error"], float)
+            outlier = data.get("outlier")  # absent (written before the limit): none
+            outlier = math.inf if outlier is None else float(outlier)
         except (TypeError, ValueError, KeyError) as exc:
             raise InputError(f"{where}: not a channel signature ({exc})") from None
+        if not outlier > 0:
+            raise InputError(f"{where}: outlier must be a positive misfit or null, got {outlier}")
         c, m = len(CHANNELS), len(MECHANICAL_CLASSES)
         j = parts[1].shape[-1] if parts[1].ndim == 2 else 0
         shapes = ((c, j, 3), (c, j), (m, c, j, 4), (m, c))
@@ -258,7 +274,7 @@ class Signatures:
                 f"{where}: a signature of channels {channels} over {parts[1].shape} joints; "
                 f"this version reads {list(CHANNELS)}"
             )
-        return cls(*parts, use, detect, margin, error)
+        return cls(*parts, use, detect, margin, error, outlier)
 
 
 def _speed_fit(readings: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -351,7 +367,8 @@ def adapt(episodic: Signatures, days: Iterable[tuple[np.ndarray, np.ndarray, int
     healthy level and spread are re-fitted on the joints at severity 0; each (mode, channel)'s
     response is scaled by the least-squares ratio of the days' excess to the episodes'
     prediction, pooled over joints, and read only where that ratio lies in :data:`TRUSTED`;
-    then how far the days stray from that response is measured (:func:`_relative_error`)."""
+    then how far the days stray from that response is measured (:func:`_relative_error`). A
+    severity read counts each channel's misfit up to :data:`OUTLIER`."""
     days = list(days)
     healthy = [r[:, j] for r, truth, _ in days for j in np.flatnonzero(np.asarray(truth) == 0)]
     if len(healthy) < 6:
@@ -380,7 +397,7 @@ def adapt(episodic: Signatures, days: Iterable[tuple[np.ndarray, np.ndarray, int
     response = episodic.response * np.where(use, ratio, 0.0)[:, :, None, None]
     response[~np.isfinite(episodic.response)] = np.nan
     error = _relative_error(baseline, spread, response, days)  # 0 where a channel is unread
-    return Signatures(baseline, spread, response, use, DETECT, MARGIN, error)
+    return Signatures(baseline, spread, response, use, DETECT, MARGIN, error, OUTLIER)
 
 
 def _relative_error(

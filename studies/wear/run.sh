@@ -27,6 +27,9 @@ if part planner; then
   # (severity_channels.md): the MAE is also given without it
   $PY studies/wear/planner_tables.py outputs/lives/planner_s{42,43,44}/lives.json \
       --unobservable struct_weaken:shoulder_pan > studies/wear/results/planner.md
+  # how far one channel may pull the signatures' severity read, chosen on the validation lives
+  $PY studies/wear/outlier_grid.py outputs/lives/planner_s{42,43,44} \
+      > studies/wear/results/outlier_grid.md
   # the wearing joint's severity: the index against the channel each mode acts on
   $PY studies/wear/severity_channels.py outputs/lives/planner_s42 \
       > studies/wear/results/severity_channels.md

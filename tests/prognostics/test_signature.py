@@ -15,7 +15,13 @@ from robohealth_mj.common.errors import InputError
 from robohealth_mj.prognostics.channels import CHANNELS, channel_readings
 from robohealth_mj.prognostics.health import MECHANICAL_CLASSES
 from robohealth_mj.prognostics.index_model import ChannelFits, FittedIndex, IndexModel, fit_index
-from robohealth_mj.prognostics.signature import Signatures, _growing_fit, adapt, fit_signatures
+from robohealth_mj.prognostics.signature import (
+    OUTLIER,
+    Signatures,
+    _growing_fit,
+    adapt,
+    fit_signatures,
+)
 from robohealth_mj.schema import FAULT_CLASSES, FEATURE_NAMES
 
 J = 2
@@ -261,6 +267,33 @@ def test_a_channel_that_strays_from_day_to_day_stops_outvoting_one_that_tracks_t
     assert again.read(day, mode) == scattered.read(day, mode)
 
 
+def test_one_channel_that_strays_far_from_its_response_cannot_drag_the_read():
+    """A softer drive moves the lag, the compliance and the dead zone 100 spreads per unit
+    severity. A day at 0.4 whose lag and compliance read 40 but whose dead zone reads 150 (that
+    joint's days stray from the episodes' shape there) reads 0.4 from the two that agree; with
+    no limit on one channel's misfit the stray one drags it to 0.77. A saved signature keeps
+    its limit; one saved before the limit existed reads without it."""
+    c = len(CHANNELS)
+    spring = MECHANICAL_CLASSES.index("struct_weaken")
+    lag, compliance, gap = (CHANNELS.index(k) for k in ("lag", "compliance", "gap"))
+    response = np.zeros((len(MECHANICAL_CLASSES), c, 1, 4))
+    response[spring, [lag, compliance, gap], :, 0] = 100.0
+    limited = dataclasses.replace(_by_hand(margin=20.0), response=response, outlier=25.0)
+    day = np.zeros((c, 1))
+    day[lag], day[compliance], day[gap] = 40.0, 40.0, 150.0
+    mode = np.array([spring])
+    assert limited.read(day, mode)[0] == pytest.approx(0.4, abs=0.01)
+    unlimited = dataclasses.replace(limited, outlier=np.inf)
+    assert unlimited.read(day, mode)[0] == pytest.approx(0.77, abs=0.01)
+    saved = json.loads(json.dumps(limited.to_json()))
+    assert Signatures.from_json(saved, "signatures.json").read(day, mode) == limited.read(day, mode)
+    del saved["outlier"]
+    older = Signatures.from_json(saved, "signatures.json")
+    assert older.read(day, mode) == unlimited.read(day, mode)
+    with pytest.raises(InputError, match=r"signatures.json: outlier must be a positive misfit"):
+        Signatures.from_json({**saved, "outlier": -1.0}, "signatures.json")
+
+
 def test_the_days_set_how_far_each_channel_strays(world):
     """A lag that swings by a random factor from day to day is given a larger share of error
     than the same lag read faithfully; a channel a mode never reads is given none."""
@@ -276,6 +309,7 @@ def test_the_days_set_how_far_each_channel_strays(world):
     faithful, swinging = adapt(episodic, days).error, adapt(episodic, swung).error
     assert faithful[backlash, lag] < 0.1 and swinging[backlash, lag] > 0.2
     assert (faithful[~adapt(episodic, days).use] == 0).all()
+    assert adapt(episodic, days).outlier == OUTLIER  # what a day's severity read is limited by
 
 
 def _loaded_days(spring: bool, loads=(30.0, 24.0, 36.0, 30.0, 24.0)) -> np.ndarray:
