@@ -195,14 +195,19 @@ def channel_fits(run_dir: Path, extra: list[str], scores: dict) -> ChannelFits:
     if not caches:
         return ChannelFits()
     scales = np.round(fit_scales(caches, len(JOINT_NAMES)), 8)
-    days = [(np.asarray(d["channel"], float), np.asarray(d["truth"], float),
-             MECHANICAL_CLASSES.index(life["mode"]) if life["mode"] else -1)
-            for life in lives_of(scores, (TRAIN,)) for d in life["days"]]  # fmt: skip
-    signatures = adapt(fit_signatures(caches, len(JOINT_NAMES)), days).to_json()
+    signatures = adapt(fit_signatures(caches, len(JOINT_NAMES)), training_days(scores)).to_json()
     atomic_write_json(scales_path, scales.tolist())
     atomic_write_json(signatures_path, signatures)
     # as written, so that a rerun reading the files reads the same numbers
     return ChannelFits(scales, Signatures.from_json(signatures, str(signatures_path)))
+
+
+def training_days(scores: dict) -> list[tuple[np.ndarray, np.ndarray, int]]:
+    """The training lives' days as :func:`adapt` brings the signatures to whole days:
+    ``(readings [C, J], truth [J], the life's mode index or -1 for a healthy life)``."""
+    return [(np.asarray(d["channel"], float), np.asarray(d["truth"], float),
+             MECHANICAL_CLASSES.index(life["mode"]) if life["mode"] else -1)
+            for life in lives_of(scores, (TRAIN,)) for d in life["days"]]  # fmt: skip
 
 
 def calibration_days(ckpt: Path, scores: dict) -> list[dict]:

@@ -23,7 +23,6 @@ import campaign  # this folder's lives campaign: the runs' cached scores and cha
 import numpy as np
 
 from robohealth_mj.learn.trainer import CHECKPOINT
-from robohealth_mj.prognostics.health import MECHANICAL_CLASSES
 from robohealth_mj.prognostics.index_model import ChannelFits, IndexModel
 from robohealth_mj.prognostics.signature import adapt, fit_signatures
 from robohealth_mj.reporting.markdown import heading
@@ -34,17 +33,21 @@ CHOSEN = IndexModel("signature", "none", True)
 
 
 def wearing_joint_mae(scores: dict, indexes: dict) -> dict[str, float]:
-    """Per group of lives, the wearing joint's index against the truth, day by day."""
+    """Per group of lives, the wearing joint's index as the monitor reads it day by day against
+    the truth (the campaign's own figure; no warning replayed)."""
     out = {}
     for group, roles in campaign.GROUPS.items():
-        errors = []
-        for life in campaign.lives_of(scores, roles):
-            if life["joint"]:
-                j = JOINT_NAMES.index(life["joint"])
-                seen = indexes[life["name"]].life(life["days"])[:, j]
-                truth = np.array([d["truth"][j] for d in life["days"]])
-                errors += np.abs(seen - truth).tolist()
-        out[group] = float(np.mean(errors))
+        views = [
+            campaign.LifeView(
+                life,
+                np.array([d["day"] for d in life["days"]], float),
+                np.array([d["truth"] for d in life["days"]]),
+                indexes[life["name"]].life(life["days"]),
+                {},
+            )
+            for life in campaign.lives_of(scores, roles)
+        ]
+        out[group] = campaign.index_figures(views)["wearing_joint_mae"]
     return out
 
 
@@ -67,11 +70,7 @@ def main() -> None:
         for name, life in scores.items():
             life["name"] = name
         campaign.add_channels(scores)
-        days = [(np.asarray(d["channel"], float), np.asarray(d["truth"], float),
-                 MECHANICAL_CLASSES.index(life["mode"]) if life["mode"] else -1)
-                for life in campaign.lives_of(scores, (campaign.TRAIN,))
-                for d in life["days"]]  # fmt: skip
-        signatures = adapt(episodic, days)
+        signatures = adapt(episodic, campaign.training_days(scores))
         scales = np.array(json.loads((run / "channel_scales.json").read_text()))
         cal_days = campaign.calibration_days(run / "model" / CHECKPOINT, scores)
         for limit in LIMITS:
