@@ -2,13 +2,13 @@
 
     python studies/wear/outlier_grid.py outputs/lives/planner_s4{2,3,4} > results/outlier_grid.md
 
-For each run (its cached scores and channel readings), the signatures are fitted again on the
-standard corpus's training sessions and the training lives, as the campaign fits them, and the
-chosen index model (``signature+none+monotone``) reads every life with each limit on one
-channel's squared misfit (:data:`robohealth_mj.prognostics.signature.OUTLIER`; none: the read
-before the limit). Cells: the wearing joint's index MAE, as the monitor reads it day by day,
-on the validation lives (where the limit is chosen), the held-out and the fresh lives. The
-warnings are not replayed here: the campaign does that for the limit chosen.
+For each run (its cached scores and channel readings, and the signatures the campaign fitted on
+the standard corpus's training sessions and the training lives), the chosen index model
+(``signature+none+monotone``) reads every life with each limit on one channel's squared misfit
+(:data:`robohealth_mj.prognostics.signature.OUTLIER`; none: the read before the limit). Cells:
+the wearing joint's index MAE, as the monitor reads it day by day, on the validation lives (where
+the limit is chosen), the held-out and the fresh lives. The warnings are not replayed here: the
+campaign does that for the limit chosen.
 """
 
 from __future__ import annotations
@@ -23,10 +23,8 @@ import campaign  # this folder's lives campaign: the runs' cached scores and cha
 import numpy as np
 
 from robohealth_mj.learn.trainer import CHECKPOINT
-from robohealth_mj.prognostics.index_model import ChannelFits, IndexModel
-from robohealth_mj.prognostics.signature import adapt, fit_signatures
+from robohealth_mj.prognostics.index_model import IndexModel
 from robohealth_mj.reporting.markdown import heading
-from robohealth_mj.schema import JOINT_NAMES
 
 LIMITS = (math.inf, 9.0, 16.0, 20.0, 25.0, 36.0, 50.0)
 CHOSEN = IndexModel("signature", "none", True)
@@ -54,12 +52,12 @@ def wearing_joint_mae(scores: dict, indexes: dict) -> dict[str, float]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", type=Path)
-    ap.add_argument("--standard", default="outputs/corpus/standard", type=Path)
+    ap.add_argument(
+        "--standard",
+        default="outputs/corpus/standard",
+        help="where a run's signatures are fitted if it has none yet (as the campaign fits them)",
+    )
     args = ap.parse_args()
-    caches = [
-        c for p in sorted(args.standard.glob("train_*")) if (c := p / campaign.CACHE).is_file()
-    ]
-    episodic = fit_signatures(caches, len(JOINT_NAMES))
     head = ["limit (squared scatters)"]
     head += [f"{run.name}: {group}" for run in args.runs for group in campaign.GROUPS]
     head.append("validation, mean over runs")
@@ -70,11 +68,10 @@ def main() -> None:
         for name, life in scores.items():
             life["name"] = name
         campaign.add_channels(scores)
-        signatures = adapt(episodic, campaign.training_days(scores))
-        scales = np.array(json.loads((run / "channel_scales.json").read_text()))
+        fitted = campaign.channel_fits(run, [f"{args.standard}/train_*"], scores)
         cal_days = campaign.calibration_days(run / "model" / CHECKPOINT, scores)
         for limit in LIMITS:
-            fits = ChannelFits(scales, replace(signatures, outlier=limit))
+            fits = replace(fitted, signatures=replace(fitted.signatures, outlier=limit))
             indexes = campaign.fitted_indexes(CHOSEN, scores, cal_days, fits)
             mae = wearing_joint_mae(scores, indexes)
             rows[limit] += [f"{v:.4f}" for v in mae.values()]
