@@ -50,7 +50,9 @@ def onnx_flops(session_factory, model: bytes | str, feeds: dict[str, np.ndarray]
     """Multiply-add FLOPs (MatMul, Gemm, Einsum and the int8 products MatMulInteger and
     QLinearMatMul, counted alike; 2 per multiply-add) of one run of an ONNX model
     on ``feeds``, read off onnxruntime's own profile of that run: the shapes each node saw.
-    ``session_factory(model, options)`` opens the session (so the caller picks providers)."""
+    ``session_factory(model, options)`` opens the session (so the caller picks providers);
+    ``feeds`` may hold more inputs than the graph takes (an incremental encode without
+    ``z_first``)."""
     import json
     import os
 
@@ -67,7 +69,11 @@ def onnx_flops(session_factory, model: bytes | str, feeds: dict[str, np.ndarray]
     options.enable_profiling = True
     options.graph_optimization_level = ort.GraphOptimizationLevel.ORT_DISABLE_ALL
     session = session_factory(model, options)
-    session.run(None, feeds)
+    try:
+        session.run(None, {i.name: feeds[i.name] for i in session.get_inputs()})
+    except BaseException:  # no profile file left behind in the caller's directory
+        os.remove(session.end_profiling())
+        raise
     path = session.end_profiling()
     try:
         with open(path) as f:

@@ -156,18 +156,19 @@ def incremental_graphs(
     step, head = SnapshotStep(model, pre).eval(), PooledHead(model).eval()
     with torch.no_grad():
         z = pre(run[:2, None])[:, 0]
-        z, g, _ = step(run[:2], z, z, torch.ones(2))
+        z, g = step(run[:2], z, torch.ones(2))
     n, f, channels = z.shape[1], z.shape[2], g.shape[2]
     signals = f - model.backbone.encoder.first_signal
     examples = (torch.zeros(2, n, 3 * channels + 7 * signals + f - signals), z)
     blobs = {}
     with tempfile.TemporaryDirectory() as tmp:
+        first = (z.clone() + 1.0,) if step.first_record else ()  # distinct: aliases merge
         export_module(
             step,
-            (run[:2], z, z.clone() + 1.0, torch.ones(2)),  # distinct: aliased inputs merge
+            (run[:2], z, torch.ones(2), *first),
             f"{tmp}/encode.onnx",
-            ["x_new", "z_prev", "z_first", "has_prev"],
-            ["z_new", "g_new", "g_first"],
+            step.input_names,
+            step.output_names,
         )
         export_module(
             head,

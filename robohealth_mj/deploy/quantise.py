@@ -48,6 +48,9 @@ class _Recorder:
         self.feeds.append({k: np.array(v, copy=True) for k, v in feeds.items()})
         return self.session.run(names, feeds)
 
+    def get_inputs(self):
+        return self.session.get_inputs()
+
 
 class _Feeds:
     """onnxruntime's calibration reader over a list of recorded feeds."""

@@ -77,6 +77,11 @@ def _attention(hidden: int, heads: int, dropout: float) -> nn.Module:
     )
 
 
+def _with_zero_step(step: torch.Tensor) -> torch.Tensor:
+    """``[B, W - 1, ...]`` steps -> ``[B, W, ...]``, the oldest snapshot's step zero."""
+    return torch.cat([torch.zeros_like(step[:, :1]), step], dim=1)
+
+
 class WindowEncoder(nn.Module):
     """Per-node temporal encoder shared by all nodes; it sees the whole window at once.
 
@@ -86,7 +91,10 @@ class WindowEncoder(nn.Module):
       heavy-tailed);
     - a per-snapshot MLP over each snapshot and its first difference ``[x_t, x_t - x_{t-1}]``,
       pooled by mean, std and max over time: learned nonlinear mixes of channels (effort against
-      the sign of velocity, say) that no per-channel statistic holds, at matmul cost;
+      the sign of velocity, say) that no per-channel statistic holds, at matmul cost. With
+      ``first_record`` the window's oldest snapshot is pooled too, with a zero step; without it
+      only the W - 1 snapshots that have a step are, so a streaming monitor computes each
+      snapshot's record once (:mod:`robohealth_mj.models.incremental`), not twice;
     - dilated temporal convolutions pooled the same way (longer local patterns; 4x slower).
 
     A learned per-node embedding then tells the shared encoder's output which node it came from.
@@ -107,11 +115,13 @@ class WindowEncoder(nn.Module):
         snapshot_mlp: bool = True,
         node_embedding: bool = True,
         first_signal: int = 2,
+        first_record: bool = True,
     ) -> None:
         super().__init__()
         if not (convolutions or statistics or snapshot_mlp):
             raise ValueError("the window encoder needs statistics, a snapshot MLP or convolutions")
         self.first_signal = first_signal
+        self.first_record = first_record
         pad = kernel // 2
         self.conv = (
             nn.Sequential(
@@ -160,8 +170,13 @@ class WindowEncoder(nn.Module):
         b, w, n, f = x.shape
         views = []
         if self.snapshot is not None:
-            step = torch.cat([torch.zeros_like(x[:, :1]), x[:, 1:] - x[:, :-1]], dim=1)
-            views.append(self._pool(self.snapshot(torch.cat([x, step], dim=-1)), 1))
+            step = x[:, 1:] - x[:, :-1]
+            if self.first_record:
+                views.append(
+                    self._pool(self.snapshot(torch.cat([x, _with_zero_step(step)], -1)), 1)
+                )
+            else:
+                views.append(self._pool(self.snapshot(torch.cat([x[:, 1:], step], -1)), 1))
         if self.conv is not None:
             seq = self.conv(x.permute(0, 2, 3, 1).reshape(b * n, f, w))  # [B*N, C, W]
             views.append(self._pool(seq.transpose(1, 2), 1).reshape(b, n, -1))
@@ -198,6 +213,7 @@ class WindowBackbone(nn.Module):
         statistics: bool = True,
         snapshot_mlp: bool = True,
         node_embedding: bool = True,
+        first_record: bool = True,
     ) -> None:
         super().__init__()
         del window  # the encoder pools over time: any W works
@@ -212,6 +228,7 @@ class WindowBackbone(nn.Module):
             statistics=statistics,
             snapshot_mlp=snapshot_mlp,
             node_embedding=node_embedding,
+            first_record=first_record,
         )
         self.convs = nn.ModuleList(
             [graph_conv(hidden=hidden, dropout=dropout, heads=heads) for _ in range(layers)]

@@ -7,16 +7,19 @@ so a stream can keep per-snapshot records in a ring and the sums running, and th
 runs only twice per tick:
 
 - ``SnapshotStep`` (one snapshot): raw sample -> normalised ``z``, its record ``g`` (with the
-  step from the previous sample) and ``g`` of the window's new first snapshot with a zero step
-  (the windowed encoder gives the first snapshot of a window no step);
+  step from the previous sample) and, where the encoder pools the window's oldest snapshot too
+  (``first_record``), ``g`` of the window's new oldest snapshot with a zero step (the windowed
+  encoder gives the oldest snapshot of a window no step); without it each sample's record is
+  computed once and the oldest snapshot's record simply leaves the pool;
 - ``PooledHead`` (one window's pooled views): the encoder's projection, message passing and the
   output heads, shared with :class:`~robohealth_mj.models.stgnn.STGNN` itself.
 
 The pooling between them lives in :mod:`robohealth_mj.runtime.incremental`; a test holds the
 whole chain equal to the windowed model.
 
-Shapes: ``SnapshotStep``: ``x_new [B, N, F]`` raw, ``z_prev, z_first [B, N, F]`` normalised,
-``has_prev [B]`` -> ``z_new [B, N, F]``, ``g_new, g_first [B, N, G]``. ``PooledHead``:
+Shapes: ``SnapshotStep``: ``x_new [B, N, F]`` raw, ``z_prev [B, N, F]`` normalised, ``has_prev
+[B]`` (and ``z_first [B, N, F]`` with ``first_record``) -> ``z_new [B, N, F]``, ``g_new [B, N,
+G]`` (and ``g_first [B, N, G]``). ``PooledHead``:
 ``views [B, N, 3G + 7S + 2]`` (the encoder's pooled views in its order: mean, std and max of
 ``g``; the window statistics, asinh-compressed; the node-type flags), ``z_last [B, N, F]`` ->
 class and joint logits. The runtime assembles the views in numpy, in one buffer (no concat
@@ -49,17 +52,28 @@ class SnapshotStep(nn.Module):
         super().__init__()
         self.pre = pre
         self.snapshot = model.backbone.encoder.snapshot
+        self.first_record = model.backbone.encoder.first_record
+
+    @property
+    def input_names(self) -> list[str]:
+        return ["x_new", "z_prev", "has_prev"] + (["z_first"] if self.first_record else [])
+
+    @property
+    def output_names(self) -> list[str]:
+        return ["z_new", "g_new"] + (["g_first"] if self.first_record else [])
 
     def forward(
         self,
         x_new: torch.Tensor,
         z_prev: torch.Tensor,
-        z_first: torch.Tensor,
         has_prev: torch.Tensor,
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        z_first: torch.Tensor | None = None,
+    ) -> tuple[torch.Tensor, ...]:
         z_new = self.pre(x_new.unsqueeze(1)).squeeze(1)
         step = (z_new - z_prev) * has_prev[:, None, None]
         g_new = self.snapshot(torch.cat([z_new, step], dim=-1))
+        if z_first is None:
+            return z_new, g_new
         g_first = self.snapshot(torch.cat([z_first, torch.zeros_like(z_first)], dim=-1))
         return z_new, g_new, g_first
 

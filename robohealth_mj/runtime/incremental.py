@@ -71,8 +71,9 @@ class IncrementalEngine(_Engine):
 
     A window's statistics come from float64 running sums (means, stds, mean ``|step|``) and from
     maxima (the snapshot MLP ``g``, ``|step|``, the signals and their negation: a minimum is the
-    negated maximum of the negation). The window's oldest snapshot counts with a zero step and
-    its own ``g_first`` (as the windowed encoder sees it); the W - 1 newer ones count as recorded.
+    negated maximum of the negation). The W - 1 newest snapshots' ``g`` count as recorded; the
+    window's oldest counts with a zero step and its own ``g_first`` where the encoder pools it
+    (``first_record``: the exported ``encode`` then takes ``z_first``), and not at all otherwise.
     Their maximum is kept by blocks of W - 1 snapshots (van Herk / Gil-Werman): a running maximum
     of the current block (``prefix``) and the suffix maxima of the previous block (``suffix``,
     computed once when a block completes), so a tick reads three records per stream instead of
@@ -101,6 +102,7 @@ class IncrementalEngine(_Engine):
             raise ValueError(f"the incremental form needs a window of at least 2, not {window}")
         super().__init__(window, capacity)
         self.encode, self.head_session = encode, head
+        self.first_record = "z_first" in {i.name for i in encode.get_inputs()}
         self.g, self.first, self.s = channels, first_signal, features - first_signal
         self.block = window - 1
         record = channels + 3 * self.s  # g, |step|, signal, -signal
@@ -111,7 +113,8 @@ class IncrementalEngine(_Engine):
         # the current block's running maximum (a block cut short by a reset is never read: a
         # window fills in W pushes, by when the block it ends in started after the reset)
         self.prefix = np.zeros((capacity, nodes, record), np.float32)
-        self.g_fixed = np.zeros((capacity, nodes, channels), np.float32)  # the oldest's g_first
+        # the oldest's g_first (written and read only with first_record)
+        self.g_fixed = np.zeros((capacity, nodes, channels), np.float32)
         self.phase = np.arange(capacity, dtype=np.int64) % self.block  # next block position
         self.sum_z = np.zeros((capacity, nodes, self.s))
         self.sq_z = np.zeros((capacity, nodes, self.s))
@@ -133,7 +136,7 @@ class IncrementalEngine(_Engine):
         kernels.push_snapshots(
             slots, z_new, g_new, g_first, has_prev, self.z, self.raw, self.suffix, self.prefix,
             self.g_fixed, self.sum_z, self.sq_z, self.sum_g, self.sq_g, self.sum_d, self.head,
-            self.count, self.phase, self.first,
+            self.count, self.phase, self.first, self.first_record,
         )  # fmt: skip
 
     def ensure(self, capacity: int) -> None:
@@ -156,14 +159,13 @@ class IncrementalEngine(_Engine):
         """Add one raw snapshot ``x [B, 2J, F]`` to each stream in ``slots`` (distinct)."""
         w = self.window
         h = self.head[slots]
-        z_prev, z_first = self.z[(h - 1) % w, slots], self.z[(h + 1) % w, slots]
         has_prev = (self.count[slots] > 0).astype(np.float32)
-        z_new, g_new, g_first = self.encode.run(
-            None,
-            {"x_new": x, "z_prev": z_prev, "z_first": z_first, "has_prev": has_prev},
-        )
+        feeds = {"x_new": x, "z_prev": self.z[(h - 1) % w, slots], "has_prev": has_prev}
+        if self.first_record:
+            feeds["z_first"] = self.z[(h + 1) % w, slots]
+        z_new, g_new, *first = self.encode.run(None, feeds)
         self.clock.mark("encode (ONNX)")
-        self._push_state(slots, z_new, g_new, g_first, has_prev)
+        self._push_state(slots, z_new, g_new, first[0] if first else g_new, has_prev)
         self.clock.mark("rings, sums")
 
     def views(self, slots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -175,6 +177,7 @@ class IncrementalEngine(_Engine):
         kernels.fill_views(
             slots, views, last, self.z, self.head, self.prefix, self.suffix, self.phase,
             self.g_fixed, self.sum_g, self.sq_g, self.sum_z, self.sq_z, self.sum_d, self.first,
+            self.first_record,
         )  # fmt: skip
         return views, last
 

@@ -10,6 +10,8 @@ the numpy code's. The kernels release the GIL: the fleet's shard threads run the
 Shapes: ``B`` streams this call, ``W`` window, ``N`` nodes, ``F`` features (``f0`` of them
 indicators, ``S = F - f0`` signals), ``G`` snapshot-MLP channels, ``R = G + 3S`` record channels
 (``g``, ``|step|``, signal, -signal). Rings are time-major ``[W, capacity, N, ...]``.
+``first_record``: whether the window pools its oldest snapshot's ``g`` (``g_first``, with a
+zero step), as the encoder it serves does.
 """
 
 from __future__ import annotations
@@ -30,10 +32,13 @@ def _max(a, b):
 def push_snapshots(
     slots, z_new, g_new, g_first, has_prev,
     z, raw, suffix, prefix, g_fixed, sum_z, sq_z, sum_g, sq_g, sum_d, head, count, phase, f0,
+    first_record,
 ):  # fmt: skip
     """Write each stream's new snapshot (``z_new [B, N, F]``, ``g_new``/``g_first [B, N, G]``)
     into its rings, running sums and block maxima (see
-    :class:`~robohealth_mj.runtime.incremental.IncrementalEngine`)."""
+    :class:`~robohealth_mj.runtime.incremental.IncrementalEngine`). Without ``first_record``
+    the sums of ``g`` hold the W - 1 newest records only (``g_first`` is not read): the new
+    oldest's record leaves them."""
     w = z.shape[0]
     block = w - 1
     n_nodes, n_g = g_new.shape[1], g_new.shape[2]
@@ -49,14 +54,19 @@ def push_snapshots(
         for n in range(n_nodes):
             for k in range(n_g):
                 new = np.float64(g_new[i, n, k])
-                old = np.float64(g_fixed[slot, n, k]) if leaves else 0.0
-                was = np.float64(raw[first, slot, n, k])
-                fixed = np.float64(g_first[i, n, k]) if fixes else was
-                delta = new - old
-                delta += fixed
-                delta -= was
-                sum_g[slot, n, k] += delta
-                sq_g[slot, n, k] += new * new - old * old + fixed * fixed - was * was
+                if first_record:
+                    old = np.float64(g_fixed[slot, n, k]) if leaves else 0.0
+                    was = np.float64(raw[first, slot, n, k])
+                    fixed = np.float64(g_first[i, n, k]) if fixes else was
+                    delta = new - old
+                    delta += fixed
+                    delta -= was
+                    sum_g[slot, n, k] += delta
+                    sq_g[slot, n, k] += new * new - old * old + fixed * fixed - was * was
+                else:
+                    was = np.float64(raw[first, slot, n, k]) if fixes else 0.0
+                    sum_g[slot, n, k] += new - was
+                    sq_g[slot, n, k] += new * new - was * was
                 record[n, k] = g_new[i, n, k]
             for k in range(n_s):
                 signal = z_new[i, n, f0 + k]
@@ -77,7 +87,8 @@ def push_snapshots(
                 record[n, n_g + 2 * n_s + k] = -signal
         z[h, slot] = z_new[i]
         raw[h, slot] = record[:, : n_g + n_s]
-        g_fixed[slot] = g_first[i]
+        if first_record:
+            g_fixed[slot] = g_first[i]
         p = phase[slot]
         for n in range(n_nodes):
             for k in range(record.shape[1]):
@@ -117,13 +128,14 @@ def _asinh(x):
 @nb.njit(cache=True, nogil=True)
 def fill_views(
     slots, views, last, z, head, prefix, suffix, phase, g_fixed, sum_g, sq_g, sum_z, sq_z, sum_d,
-    f0,
+    f0, first_record,
 ):  # fmt: skip
     """The pooled head's inputs of each (full) window: ``views [B, N, 3G + 7S + f0]`` (mean, std
     and max of ``g``; per signal, statistics-major, the asinh of mean, std, min, max, last -
     first, mean ``|step|``, max ``|step|``; the newest snapshot's indicators) and ``last [B, N,
     F]``, the newest normalised snapshot."""
     w = z.shape[0]
+    records = w if first_record else w - 1  # snapshots whose g the window pools
     n_nodes, n_g = g_fixed.shape[1], g_fixed.shape[2]
     n_s = z.shape[3] - f0
     for i in range(len(slots)):
@@ -133,11 +145,12 @@ def fill_views(
         last[i] = z[newest, slot]
         for n in range(n_nodes):
             for k in range(n_g):
-                mean = sum_g[slot, n, k] / w
+                mean = sum_g[slot, n, k] / records
                 views[i, n, k] = mean
-                views[i, n, n_g + k] = np.sqrt(max(sq_g[slot, n, k] / w - mean * mean, 1e-12))
+                spread = sq_g[slot, n, k] / records - mean * mean
+                views[i, n, n_g + k] = np.sqrt(max(spread, 1e-12))
                 peak = _max(prefix[slot, n, k], suffix[p, slot, n, k])
-                views[i, n, 2 * n_g + k] = _max(peak, g_fixed[slot, n, k])
+                views[i, n, 2 * n_g + k] = _max(peak, g_fixed[slot, n, k]) if first_record else peak
             for k in range(n_s):
                 at = 3 * n_g + 7 * k
                 oldest = z[h, slot, n, f0 + k]

@@ -3,6 +3,10 @@ std over seeds, through onnxruntime) beside what it costs (MFLOP per stream-tick
 sustained), from the runner's outputs.
 
     python studies/cost_frontier/summarise.py outputs/cost_frontier studies/cost_frontier/results
+
+A later pass that measures a few forms again (one or more bench runs: each model's median)
+writes its own table beside the first (``--bench``, ``--scores``, ``--name``); its on-line rows
+are those of its forms.
 """
 
 from __future__ import annotations
@@ -32,34 +36,42 @@ CHANGES = {
     "h16c8_kd": "hidden 16, snapshot MLP 8, distilled from the headline",
     "h64_l1": "one message-passing layer",
     "h16_w16": "hidden 16, W = 16",
+    "h64s": "no snapshot-MLP record of the window's oldest snapshot (one record a sample)",
 }
+ONLINE_ENTRY = re.compile(r"^(.+)_k(\d+)(?:_s(\d+))?$")  # form, k, seed (absent: 42)
 BENCH_ROW = re.compile(r"^\| (\S+) \| ([\d.]+) \| [\d.]+ \| (\d+) \| [\d.]+ \|$")
 
 
-def bench_rows(path: Path) -> dict[tuple[str, str, int], dict]:
-    """``(form, file kind, k) -> {mflop, sustained}`` from ``bench streams --compare``'s table
-    (``k``: the model run every k-th tick)."""
-    out = {}
-    if not path.is_file():
-        return out
-    for line in path.read_text().splitlines():
-        m = BENCH_ROW.match(line)
-        if m:
-            file, _, every = m.group(1).partition("@")
-            model = Path(file)
-            key = (model.parent.parent.name, FILES[model.name], int(every or 1))
-            # MFLOP counted again: the int8 products were left out of the counter at first
-            mflop = model_flops(str(model)) / 1e6 / key[2] if model.is_file() else float(m.group(2))
-            out[key] = {"mflop": mflop, "sustained": int(m.group(3))}
+def bench_rows(paths: list[Path]) -> dict[tuple[str, str, int], dict]:
+    """``(form, file kind, k) -> {mflop, sustained}`` from ``bench streams --compare``'s tables
+    (``k``: the model run every k-th tick); with several runs, each model's median sustained."""
+    out: dict[tuple[str, str, int], dict] = {}
+    for path in paths:
+        if not path.is_file():
+            continue
+        for line in path.read_text().splitlines():
+            m = BENCH_ROW.match(line)
+            if m:
+                file, _, every = m.group(1).partition("@")
+                model = Path(file)
+                key = (model.parent.parent.name, FILES[model.name], int(every or 1))
+                # MFLOP counted again: the int8 products were left out of the counter at first
+                mflop = (
+                    model_flops(str(model)) / 1e6 / key[2] if model.is_file() else float(m.group(2))
+                )
+                row = out.setdefault(key, {"mflop": mflop, "runs": []})
+                row["runs"].append(int(m.group(3)))
+    for row in out.values():
+        row["sustained"] = int(np.median(row["runs"]))
     return out
 
 
-def online_rows(results: Path, bench: dict) -> str:
+def online_rows(results: Path, bench: dict, forms: set[str]) -> str:
     """The monitor's on-line figures per (form, k), beside the bench's cost: the selection
     session and the healthy hour (what a choice may be made on), then the held-out session."""
 
-    def read(form: str, k: str, name: str) -> dict:
-        path = results / "online" / f"{form}_k{k}_{name}.json"
+    def read(entry: str, name: str) -> dict:
+        path = results / "online" / f"{entry}_{name}.json"
         return json.loads(path.read_text()) if path.is_file() else {}
 
     def alarms(d: dict) -> str:
@@ -72,25 +84,27 @@ def online_rows(results: Path, bench: dict) -> str:
         )
 
     lines = [
-        "| form | model every k ticks | MFLOP per stream-tick | sustained streams | selection "
-        "session: episodes detected | latency to class, median / p90 s | healthy hour: false "
-        "alarms per hour | selection on-line accuracy | held-out session: episodes detected | "
-        "latency to class, median / p90 s | held-out on-line accuracy / localisation |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| form | seed | model every k ticks | MFLOP per stream-tick | sustained streams | "
+        "selection session: episodes detected | latency to class, median / p90 s | healthy hour: "
+        "false alarms per hour | selection on-line accuracy | held-out session: episodes "
+        "detected | latency to class, median / p90 s | held-out on-line accuracy / localisation |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     entries = sorted({p.stem.rsplit("_", 1)[0] for p in (results / "online").glob("*.json")})
     for entry in entries:
-        form, k = entry.rsplit("_k", 1)
-        b = bench.get((form, "float", int(k)), {})
-        healthy, held = read(form, k, "healthy"), read(form, k, "heldout")
-        selection = read(form, k, "selection")
+        form, k, seed = ONLINE_ENTRY.match(entry).groups()
+        if form not in forms:
+            continue
+        b = bench.get((form, "float", int(k)), {}) if seed is None else {}
+        healthy, held = read(entry, "healthy"), read(entry, "heldout")
+        selection = read(entry, "selection")
         rate = healthy.get("false_alarms_per_hour", float("nan"))
         accuracy = (
             f"{held['online_accuracy']:.3f} / {held['localisation_accuracy']:.3f}" if held else "–"
         )
         mflop = f"{b['mflop']:.3f}" if b else "–"
         lines.append(
-            f"| {form} | {k} | {mflop} | {b.get('sustained', '–')} | "
+            f"| {form} | {seed or 42} | {k} | {mflop} | {b.get('sustained', '–')} | "
             f"{alarms(selection)} | {rate:.2f} | {selection.get('online_accuracy', 0):.3f} | "
             f"{alarms(held)} | {accuracy} |"
         )
@@ -119,9 +133,9 @@ def gbdt_row(root: Path, ref: dict[str, list[float]]) -> str | None:
     )
 
 
-def quality(root: Path) -> dict[tuple[str, str], dict[str, list[float]]]:
-    """``(form, file kind) -> {set_metric: [per seed]}`` from ``scores.json``, plus train s."""
-    scores = json.loads((root / "scores.json").read_text())
+def quality(scores_path: Path) -> dict[tuple[str, str], dict[str, list[float]]]:
+    """``(form, file kind) -> {set_metric: [per seed]}`` from ``score.py``'s file, plus train s."""
+    scores = json.loads(scores_path.read_text())
     out: dict[tuple[str, str], dict[str, list[float]]] = {}
     for key, row in sorted(scores.items()):
         model, data = key.split("::")
@@ -243,17 +257,22 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("root", type=Path)
     parser.add_argument("results", type=Path)
+    parser.add_argument("--bench", nargs="+", default=["bench_compare.txt"],
+                        help="in results; several: each model's median")  # fmt: skip
+    parser.add_argument("--scores", default="scores.json", help="in root")
+    parser.add_argument("--name", default="frontier", help="results/NAME.md and NAME.png")
     args = parser.parse_args()
-    q = quality(args.root)
-    bench = bench_rows(args.results / "bench_compare.txt")
+    q = quality(args.root / args.scores)
+    bench = bench_rows([args.results / name for name in args.bench])
+    out = args.results / f"{args.name}.md"
     atomic_write_text(
-        args.results / "frontier.md",
+        out,
         "## Quality and cost of each form\n\n" + table(q, bench, args.root)
-        + "\n## The model every k ticks: on-line figures and cost (seed 42)\n\n"
-        + online_rows(args.results, bench),
+        + "\n## The model every k ticks: on-line figures (each seed's model), cost (seed 42's)\n\n"
+        + online_rows(args.results, bench, {form for form, _ in q}),
     )  # fmt: skip
-    plot(q, bench, args.results / "frontier.png")
-    print((args.results / "frontier.md").read_text())
+    plot(q, bench, args.results / f"{args.name}.png")
+    print(out.read_text())
 
 
 if __name__ == "__main__":

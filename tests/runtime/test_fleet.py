@@ -79,26 +79,31 @@ def test_incremental_inference_equals_windowed_inference(deployed):
 
 def _window_max_by_scan(engine, slots: np.ndarray) -> np.ndarray:
     """The definition the block maxima must meet: the maximum over the window's W records,
-    the oldest counted with its ``g_first`` and no step, the others as recorded:
+    the oldest counted with no step and with its ``g_first`` (an encoder with ``first_record``)
+    or with the newest's ``g`` (one without: no record of its own), the others as recorded:
     ``[B, N, G + 3S]`` (g, |step|, signal, -signal)."""
     g, f0 = engine.g, engine.first
     out = []
     for slot in slots.tolist():
         order = (engine.head[slot] + np.arange(engine.window)) % engine.window  # oldest first
         raw = engine.raw[order, slot].copy()
-        raw[0, :, :g], raw[0, :, g:] = engine.g_fixed[slot], 0.0
+        raw[0, :, :g] = engine.g_fixed[slot] if engine.first_record else raw[-1, :, :g]
+        raw[0, :, g:] = 0.0
         signal = engine.z[order, slot][..., f0:]
         out.append(np.concatenate([raw, signal, -signal], axis=-1).max(axis=0))
     return np.stack(out)
 
 
-def test_block_window_maxima_equal_a_scan_of_the_window(deployed):
+@pytest.mark.parametrize("graph", ["structural", "harness"])
+def test_block_window_maxima_equal_a_scan_of_the_window(deployed, graph):
     """The fleet keeps window maxima by blocks (three records a tick); through gaps (windows
     restarting at any block phase) and ticks that skip streams, the views they give (max of g;
-    asinh of min, max and max |step| of each signal) equal those of a full scan."""
+    asinh of min, max and max |step| of each signal) equal those of a full scan, whether the
+    encoder pools the oldest snapshot's record (structural) or not (harness)."""
     rec = load_recordings([deployed["heldout"]])
-    fleet = FleetRuntime(deployed["structural_onnx"], chunk=4)
+    fleet = FleetRuntime(deployed[f"{graph}_onnx"], chunk=4)
     engine, streams = fleet.engine, 11
+    assert engine.first_record == (graph == "structural")
     g, s = engine.g, engine.s
     slots = fleet.register([f"s{k}" for k in range(streams)])
     rng = np.random.default_rng(3)
@@ -672,6 +677,32 @@ def test_the_fleet_reports_its_provider_and_refuses_an_unknown_one(deployed):
     assert fleet.engine is not None and fleet.providers[-1] == "CPUExecutionProvider"
     with pytest.raises(InputError, match="'NoSuchExecutionProvider'"):
         FleetRuntime(deployed["structural_onnx"], providers=["NoSuchExecutionProvider"])
+
+
+def test_an_encoder_without_the_oldest_record_costs_one_snapshot_mlp_a_sample(deployed):
+    """The point of ``first_record=false``: the fleet's per-sample graph runs the snapshot MLP
+    once, not twice (bench's FLOP counter, on the same graph width and snapshot MLP)."""
+    import base64
+
+    import onnxruntime as ort
+
+    from robohealth_mj.benchmarks.common import onnx_flops
+    from robohealth_mj.runtime.metadata import read_metadata
+
+    def encode_flops_per_node(graph: str) -> float:
+        meta = read_metadata(deployed[f"{graph}_onnx"])
+        raw = np.zeros((1, schema.N_NODES, schema.N_FEATURES), np.float32)
+        z = np.zeros((1, int(meta["incremental_nodes"]), schema.N_FEATURES), np.float32)
+        feeds = {"x_new": raw, "z_prev": z, "z_first": z, "has_prev": np.zeros(1, np.float32)}
+        return onnx_flops(
+            lambda m, o: ort.InferenceSession(m, o, providers=["CPUExecutionProvider"]),
+            base64.b64decode(meta["incremental_encode"]), feeds,
+        ) / int(meta["incremental_nodes"])  # fmt: skip
+
+    # per graph node (the harness graph has 10, the structural 12); the harness's input mapping
+    # adds 2.5 % of matrix products of its own
+    both, one = encode_flops_per_node("structural"), encode_flops_per_node("harness")
+    assert one > 0 and one == pytest.approx(both / 2, rel=0.05)
 
 
 def test_bench_streams_names_an_unknown_provider_in_one_line(deployed, capsys):
