@@ -126,6 +126,7 @@ def run_monitor(
                            health_diagnosis_hz=float(cfg.get("health_diagnosis_hz", 20.0)),
                            tick_hz=float(cfg.get("tick_hz", 20.0)),
                            diagnose_wait_s=float(cfg.get("diagnose_wait_s", 0.02)),
+                           late_ticks=int(cfg.get("late_ticks", 10)),
                            member=grouped.member if grouped is not None else None,
                            **layout_options(cfg, tracking, model_arm(runtime)))  # fmt: skip
         started = time.monotonic()

@@ -205,6 +205,7 @@ class MonitorNode:
         diagnose_wait_s: float = 0.02,
         tick_hz: float = 20.0,
         member: str | None = None,
+        late_ticks: int = 10,
     ) -> None:
         """``health_diagnosis_hz``: each arm's ``/health_diagnosis`` at most this often (every
         diagnosis at ``tick_hz``, the model's rate; less saves the monitor's publishing time at
@@ -214,8 +215,12 @@ class MonitorNode:
         (``{arm}`` is the arm's name) say what each arm's JointState messages call its joints;
         ``namespace`` where its topics live; ``driver`` the UR driver's side (``ur_driver``).
         ``diagnose_wait_s``: how long a completed sample may wait for the other arms' before
-        the runtime step (one step for the whole fleet's tick instead of a step per arm)."""
+        the runtime step (one step for the whole fleet's tick instead of a step per arm).
+        ``late_ticks``: a tick still missing a message once this many newer ticks are complete
+        is reported missing (the message, should it come, counts late)."""
         self.bus, self.runtime, self.stale_s = bus, runtime, stale_s
+        if not late_ticks >= 1:
+            raise InputError(f"ros2.late_ticks must be >= 1, got {late_ticks}")
         if not health_diagnosis_hz > 0:
             raise InputError(f"ros2.health_diagnosis_hz must be > 0, got {health_diagnosis_hz}")
         self.health_every = max(1, round(tick_hz / health_diagnosis_hz))  # every k-th diagnosis
@@ -240,7 +245,8 @@ class MonitorNode:
         self.member = member
         self._arm_options = {"topics": topics, "namespace": namespace, "layout": layout,
                              "joint_names": joint_names, "tf_prefix": tf_prefix,
-                             "driver": driver, "require_truth": require_truth}  # fmt: skip
+                             "driver": driver, "require_truth": require_truth,
+                             "late_ticks": late_ticks}  # fmt: skip
         self.diagnostics = bus.writer(
             DIAGNOSTICS_TOPIC, TYPES["diagnostic_msgs/msg/DiagnosticArray"]
         )
@@ -260,8 +266,9 @@ class MonitorNode:
         else:
             aggregated = names.aggregated if o["layout"] == "aggregated" else None
             assembler = ArmAssembler(arm, names, require_truth=o["require_truth"],
-                                     aggregated=aggregated, sensors=o["layout"] != "joints",
-                                     joints=joints, history=self.bus.config.depth)  # fmt: skip
+                                     late_ticks=o["late_ticks"], aggregated=aggregated,
+                                     sensors=o["layout"] != "joints", joints=joints,
+                                     history=self.bus.config.depth)  # fmt: skip
         # every assembler reads the bytes: the bag layouts' by byte templates, the driver's
         # decoding only the messages a tick uses
         readers = [(t, kinds[t], self.bus.reader(t, kinds[t])) for t in assembler.topic_names()]

@@ -239,16 +239,19 @@ def test_cyclonedds_uri_is_merged_after_the_project_s_settings(tmp_path, monkeyp
     assert trace.is_file() and "127.0.0.1" in trace.read_text()
 
 
-def test_a_nonsense_diagnosis_rate_is_refused_in_one_line(deployed, capsys):
+@pytest.mark.parametrize(
+    "override, message",
+    [("ros2.health_diagnosis_hz=0", "ros2.health_diagnosis_hz must be > 0, got 0.0"),
+     ("ros2.late_ticks=0", "ros2.late_ticks must be >= 1, got 0")],
+)  # fmt: skip
+def test_a_nonsense_monitor_setting_is_refused_in_one_line(deployed, capsys, override, message):
     from robohealth_mj.monitor import main
 
     with pytest.raises(SystemExit) as exit_:
         main([f"model={deployed['structural_onnx']}", "source=ros2", "ros2.interface=127.0.0.1",
-              f"ros2.domain_id={next(_DOMAINS)}", "ros2.health_diagnosis_hz=0"])  # fmt: skip
+              f"ros2.domain_id={next(_DOMAINS)}", override])  # fmt: skip
     assert exit_.value.code == 2
-    assert capsys.readouterr().err.strip().splitlines() == [
-        "monitor: error: ros2.health_diagnosis_hz must be > 0, got 0.0"
-    ]
+    assert capsys.readouterr().err.strip().splitlines() == [f"monitor: error: {message}"]
 
 
 def test_a_fleet_is_split_by_namespace_hash_with_every_arm_in_one_share():
@@ -399,6 +402,9 @@ def test_two_monitor_processes_split_four_arms_and_stop_cleanly_on_sigterm(deplo
     # history for 2.5 s of ticks at speed 4: a stalled monitor catches up with nothing lost
     common = [f"ros2.domain_id={next(_DOMAINS)}", "ros2.interface=127.0.0.1", "ros2.count=4",
               "ros2.depth=200"]  # fmt: skip
+    # a stall can overflow the loopback socket buffers; the reliable resend of what they dropped
+    # may take more than the default 10 ticks (125 ms at speed 4) on a loaded machine
+    wait_for_resends = "ros2.late_ticks=60"
     monitors = [
         subprocess.Popen(
             [
@@ -412,6 +418,7 @@ def test_two_monitor_processes_split_four_arms_and_stop_cleanly_on_sigterm(deplo
                 f"ros2.partition={k}/2",
                 "evaluate=true",
                 "ros2.reliable_subscriptions=true",  # every sample is asked for: no loss
+                wait_for_resends,
                 f"out={tmp_path / f'ros2_{k}.json'}",
             ],
             stdout=subprocess.PIPE,
