@@ -49,19 +49,23 @@ def model_flops(model: str, incremental: bool = True) -> float:
     def zeros(*shape):
         return np.zeros(shape, np.float32)
 
-    nodes, features = schema.N_NODES, schema.N_FEATURES
+    # the raw snapshot is on the arm's graph; the incremental state on the model's own nodes
+    # (fewer where an unknown-placement harness maps the sensors first)
+    raw, features = meta["arm_graph"].n_nodes, schema.N_FEATURES
     if not incremental or "incremental_encode" not in meta:
-        return onnx_flops(session, model, {"x": zeros(1, int(meta["window"]), nodes, features)})
+        return onnx_flops(session, model, {"x": zeros(1, int(meta["window"]), raw, features)})
+    nodes = int(meta["incremental_nodes"])
     g, f0 = int(meta["incremental_channels"]), int(meta["first_signal"])
     views = 3 * g + 7 * (features - f0) + f0
-    snapshot = zeros(1, nodes, features)
+    state = zeros(1, nodes, features)
     encode = onnx_flops(
         session, base64.b64decode(meta["incremental_encode"]),
-        {"x_new": snapshot, "z_prev": snapshot, "z_first": snapshot, "has_prev": zeros(1)},
+        {"x_new": zeros(1, raw, features), "z_prev": state, "z_first": state,
+         "has_prev": zeros(1)},
     )  # fmt: skip
     head = onnx_flops(
         session, base64.b64decode(meta["incremental_head"]),
-        {"views": zeros(1, nodes, views), "z_last": snapshot},
+        {"views": zeros(1, nodes, views), "z_last": state},
     )  # fmt: skip
     return encode + head
 

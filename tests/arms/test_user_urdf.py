@@ -196,6 +196,15 @@ def test_a_five_joint_users_arm_goes_through_record_train_export_and_monitor(
 
 
 @pytest.mark.slow
+def test_bench_counts_the_flops_of_a_five_joint_arms_model(toy_deployed):
+    """bench's FLOP counter feeds the model the arm's own graph (10 nodes), not the UR's 12."""
+    from robohealth_mj.benchmarks.fleet import model_flops
+
+    assert model_flops(str(toy_deployed["onnx"]), incremental=False) > 0
+    assert model_flops(str(toy_deployed["onnx"])) > 0
+
+
+@pytest.mark.slow
 def test_a_mixed_fleet_decides_each_arm_as_its_own_fleet_would(toy_deployed, deployed):
     """A six-joint UR5e model and the five-joint arm's in one process: every row of each arm
     gets the decision its arm's fleet alone gives it, and a row of one arm's graph sent to the

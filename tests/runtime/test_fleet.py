@@ -705,6 +705,17 @@ def test_an_encoder_without_the_oldest_record_costs_one_snapshot_mlp_a_sample(de
     assert one > 0 and one == pytest.approx(both / 2, rel=0.05)
 
 
+def test_bench_counts_a_graph_on_fewer_nodes_than_the_arm(deployed):
+    """The unknown-placement harness reads the arm's 12 raw nodes into 10 of its own: bench's
+    FLOP counter feeds each of its graphs the shapes that graph takes, and the fleet's
+    incremental form costs less a tick than the whole window."""
+    from robohealth_mj.benchmarks.fleet import model_flops
+
+    harness = str(deployed["harness_onnx"])
+    incremental, windowed = model_flops(harness), model_flops(harness, incremental=False)
+    assert 0 < incremental < windowed
+
+
 def test_bench_streams_names_an_unknown_provider_in_one_line(deployed, capsys):
     from robohealth_mj.bench import main as bench_main
 
