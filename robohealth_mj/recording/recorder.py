@@ -23,7 +23,7 @@ from hydra.utils import instantiate
 from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
-from robohealth_mj.arms.description import DEFAULT_ARM, load_arm, short_name
+from robohealth_mj.arms.description import DEFAULT_ARM, ArmDescription, load_arm, short_name
 from robohealth_mj.common.atomic import atomic_write_json
 from robohealth_mj.common.errors import USER_ERRORS, InputError
 from robohealth_mj.common.version import code_version
@@ -32,6 +32,7 @@ from robohealth_mj.data.windows import recorded_run_id
 from robohealth_mj.faults.injector import FaultInjector
 from robohealth_mj.recording.arm import ArmSimulator, TickChunk
 from robohealth_mj.schema import SCHEMA_VERSION, FaultLabel
+from robohealth_mj.sim.curriculum import Curriculum
 from robohealth_mj.sim.pushes import read_pushes
 from robohealth_mj.sim.twin_file import read_twin_noise
 
@@ -155,12 +156,8 @@ def _stop_between_chunks():
             signal.signal(s, h)
 
 
-def build_simulator(cfg: DictConfig) -> ArmSimulator:
-    """Instantiate model, curriculum, controller and sensors from the composed config."""
-    variation = instantiate(cfg.arm)
-    description = load_arm(variation.name)
-    nominal = instantiate(cfg.sim, arm=description.name)
-    model, arm = variation.draw(nominal, cfg.seed)  # the physics: this session's arm
+def build_curriculum(cfg: DictConfig, description: ArmDescription) -> Curriculum:
+    """The session's curriculum on the arm ``description`` (its ratings, limits and joints)."""
     make_curriculum = instantiate(
         cfg.curriculum,
         seed=cfg.seed,
@@ -170,9 +167,18 @@ def build_simulator(cfg: DictConfig) -> ArmSimulator:
         _partial_=True,  # the arm is an object, not config: given to the partial
     )
     try:
-        curriculum = make_curriculum(arm=description)
+        return make_curriculum(arm=description)
     except USER_ERRORS as exc:  # named as Hydra names a config object it could not build
         raise InputError(f"config 'curriculum': {exc}") from None
+
+
+def build_simulator(cfg: DictConfig) -> ArmSimulator:
+    """Instantiate model, curriculum, controller and sensors from the composed config."""
+    variation = instantiate(cfg.arm)
+    description = load_arm(variation.name)
+    nominal = instantiate(cfg.sim, arm=description.name)
+    model, arm = variation.draw(nominal, cfg.seed)  # the physics: this session's arm
+    curriculum = build_curriculum(cfg, description)
     controller = instantiate(cfg.control, model=nominal)  # the controller: the datasheet's
     sensors = instantiate(cfg.sensors, physics_rate_hz=1.0 / model.opt.timestep, _convert_="all")
     # the drive's torque sensing resolves the same fraction of its rating on every arm (each

@@ -27,6 +27,7 @@ from robohealth_mj.schema import JOINT_NAMES
 
 FAMILIES = ("single_joint", "joint_pair", "whole_arm", "pick_place", "hold", "cruise")
 WAVEFORMS = ("sine", "triangle", "compound")
+SWEEPS = ("single_joint", "joint_pair", "whole_arm")  # the families that sweep about a centre
 TASKS = ("pick_place", "palletise")  # the pick_place family's programs
 LEG_S = 0.8  # the shortest point-to-point move at speed scale 1, s
 JOINT_SPEED = 1.0  # rad/s: the fastest joint's peak speed in a move at speed scale 1 (a UR5e's)
@@ -64,6 +65,15 @@ def _slope_norm(name: str) -> float:
 def waveform(name: str, phi: np.ndarray) -> np.ndarray:
     """Periodic waveform with w(0) = 0 and peak slope 1 (peak speed = amplitude * 2 pi f)."""
     return _raw_waveform(name, phi) / _slope_norm(name)
+
+
+@cache
+def excursion(name: str, phase: float) -> float:
+    """Largest ``|w(theta + phase) - w(phase)|`` over a period: how far a sweep started at
+    ``phase`` swings from its centre, per unit amplitude (a sine at a quarter-period offset
+    swings 2 one way, not 1 either way)."""
+    theta = np.linspace(0.0, 2.0 * np.pi, 4001)
+    return float(np.max(np.abs(waveform(name, theta + phase) - waveform(name, np.array(phase)))))
 
 
 def smoothstep(u: np.ndarray) -> np.ndarray:
@@ -199,7 +209,6 @@ class Curriculum:
             raise InputError(f"payload_ramp_s ({payload_ramp_s}) must be in [0, blend_s]")
         self.payload_ramp_s = float(payload_ramp_s)
         self.amplitude = self.amplitude * self.speed_ratio
-        self._fit_ranges(description.position_limit)
         self.lift = self._per_joint("lift", LIFT_RAD)  # pick and place: above the part
         self.stroke = self._per_joint("stroke", CRUISE_STROKE_RAD)  # cruise: the via pose's reach
         unknown = sorted(set(families) - set(FAMILIES))
@@ -211,6 +220,7 @@ class Curriculum:
         self.cruise_repeats = int(cruise_repeats)
         self.seed = int(seed)
         self.segments = self._enumerate()
+        self._fit_ranges(description.position_limit)
         self._cache: dict[int, ScheduledSegment] = {}
 
     def _per_joint(self, name: str, values: Sequence[float]) -> np.ndarray:
@@ -225,11 +235,20 @@ class Curriculum:
         )
 
     def _fit_ranges(self, position_limit: np.ndarray) -> None:
-        """Shrink each limited joint's sweep and jitter so the home plus both fits 90 % of its
-        half-range (a UR's +-360 deg joints keep theirs)."""
-        half = 0.5 * (position_limit[:, 1] - position_limit[:, 0])
-        need = self.amplitude + self.jitter
-        room = np.where(np.isfinite(half), 0.9 * half, np.inf)
+        """Shrink each limited joint's sweep and jitter so that its farthest swing from the home
+        (the jitter plus the largest excursion of any sweep it takes part in) fits 90 % of the
+        room between the home and its nearer limit (a UR's +-360 deg joints keep theirs)."""
+        reach = np.zeros(self.n_joints)  # per unit amplitude
+        for segment in self.segments:
+            if segment.family not in SWEEPS:
+                continue  # pick_place, hold and cruise move between poses
+            factor, phase = self._family_factor(segment.family), self._phase(segment)
+            for j in segment.joints:
+                reach[j] = max(reach[j], factor * excursion(segment.waveform, float(phase[j])))
+        need = reach * self.amplitude + self.jitter
+        low, high = position_limit[:, 0], position_limit[:, 1]
+        room = 0.9 * np.minimum(self.home - low, high - self.home)
+        room = np.where(np.isfinite(room), room, np.inf)
         with np.errstate(divide="ignore", invalid="ignore"):
             factor = np.where(need > room, room / need, 1.0)
         self.amplitude = self.amplitude * factor
@@ -365,16 +384,16 @@ class Curriculum:
             t0 += duration + CRUISE_DWELL_S
         return out
 
+    def _family_factor(self, family: str) -> float:
+        """A sweeping family's amplitude, as a fraction of a single joint's sweep."""
+        return {"single_joint": 1.0, "joint_pair": self.pair_factor,
+                "whole_arm": self.whole_factor}[family]  # fmt: skip
+
     def _amplitude(self, segment: Segment) -> np.ndarray:
-        factor = {
-            "single_joint": 1.0,
-            "joint_pair": self.pair_factor,
-            "whole_arm": self.whole_factor,
-            "pick_place": 0.0,  # its motion is its waypoints
-        }[segment.family]
         amp = np.zeros(self.n_joints)
-        idx = list(segment.joints)
-        amp[idx] = self.amplitude[idx] * factor
+        if segment.family in SWEEPS:  # pick_place's motion is its waypoints
+            idx = list(segment.joints)
+            amp[idx] = self.amplitude[idx] * self._family_factor(segment.family)
         return amp
 
     def _phase(self, segment: Segment) -> np.ndarray:

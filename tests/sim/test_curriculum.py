@@ -7,8 +7,10 @@ import numpy as np
 import pytest
 from hydra.utils import instantiate
 
+from robohealth_mj.arms.description import known_arms, load_arm
 from robohealth_mj.common.errors import user_error
-from robohealth_mj.sim.curriculum import CRUISE_SPEED
+from robohealth_mj.recording.recorder import build_curriculum
+from robohealth_mj.sim.curriculum import CRUISE_SPEED, FAMILIES
 from robohealth_mj.sim.model import ArmIndex
 
 SPEED_LIMIT = 3.14  # rad/s, the UR5e joint speed limit (parameter file)
@@ -180,3 +182,17 @@ def test_cruise_repeats_sets_the_familys_weight_and_refuses_none(record_cfg):
         _curriculum(record_cfg, "curriculum.families=[cruise]", "+curriculum.cruise_repeats=0")
     line = str(user_error(caught.value))  # what every command prints, exit status 2
     assert "cruise_repeats must be at least 1, got 0" in line and "\n" not in line
+
+
+@pytest.mark.parametrize("name", known_arms())
+def test_the_reference_keeps_every_joint_inside_its_range(record_cfg, name):
+    """Every family (a pair's second joint, a quarter-period behind, swings twice its amplitude
+    one way) commands each limited joint inside its range: the FR3's tool joint was sent 0.09 rad
+    past its stop, where it sat, far off its reference."""
+    cfg = record_cfg(f"arm={name}", "seed=940", f"curriculum.families={list(FAMILIES)}")
+    arm = load_arm(name)
+    c = build_curriculum(cfg, arm)
+    low, high = arm.position_limit[:, 0], arm.position_limit[:, 1]
+    for visit in range(len(c)):
+        q = c.position(visit, c.scheduled(visit).t_start + np.linspace(0.0, c.segment_s, 200))
+        assert np.all(q >= low) and np.all(q <= high), (visit, c.scheduled(visit).segment)
