@@ -68,7 +68,7 @@ def waveform(name: str, phi: np.ndarray) -> np.ndarray:
 
 
 @cache
-def excursion(name: str, phase: float) -> float:
+def _excursion(name: str, phase: float) -> float:
     """Largest ``|w(theta + phase) - w(phase)|`` over a period: how far a sweep started at
     ``phase`` swings from its centre, per unit amplitude (a sine at a quarter-period offset
     swings 2 one way, not 1 either way)."""
@@ -244,7 +244,7 @@ class Curriculum:
                 continue  # pick_place, hold and cruise move between poses
             factor, phase = self._family_factor(segment.family), self._phase(segment)
             for j in segment.joints:
-                reach[j] = max(reach[j], factor * excursion(segment.waveform, float(phase[j])))
+                reach[j] = max(reach[j], factor * _excursion(segment.waveform, float(phase[j])))
         need = reach * self.amplitude + self.jitter
         low, high = position_limit[:, 0], position_limit[:, 1]
         room = 0.9 * np.minimum(self.home - low, high - self.home)

@@ -7,7 +7,8 @@ within 25 % of the UR5e's).
 Reads each arm's ten healthy minutes (``healthy_commissioning_seed940``: faults off, the
 standard curriculum, which sweeps every joint at the same fraction of its own speed limit, so
 the arms move at the same relative speed) and its eight training sessions' wall time (recorded
-two at a time on the same machine, the corpus's jobs). Prints a markdown table.
+two at a time on the same machine, the corpus's jobs; nan where an arm's folder holds only its
+healthy minutes). Prints a markdown table.
 """
 
 from __future__ import annotations
@@ -34,7 +35,8 @@ def arm_row(root: Path) -> dict:
     wall = sum(m["wall_s"] for m in sessions)
     simulated = sum(m["sample_count"] / m["rates"]["tick_hz"] for m in sessions)
     return {"joints": len(rms), "median_mrad": float(np.median(rms)),
-            "worst_mrad": float(rms.max()), "wall_per_sim_s": wall / simulated}  # fmt: skip
+            "worst_mrad": float(rms.max()),
+            "wall_per_sim_s": wall / simulated if sessions else float("nan")}  # fmt: skip
 
 
 def main() -> None:
