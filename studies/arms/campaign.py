@@ -5,7 +5,7 @@ commissioning, and false alarms on the unseen arm's healthy hour.
         [--epochs 10] [--sensing full] [--arms ur3e,ur5e,ur10e,ur16e] [--family ARMS]
         [--stages own,loao]
         [--steps train,rescore,commission,alarms,validate] [--healthy-rate 0.99]
-        [--normalisation sensors|shift|moments]
+        [--normalisation sensors|shift|moments] [--commissioning-minutes 10|20|30]
 
 Reads the per-arm corpora ``outputs/corpus/arms/<arm>`` (``python -m robohealth_mj.corpus
 corpus=arms ...``, see ``studies/arms/run.sh``; ``--corpus`` names another root, e.g. one
@@ -20,8 +20,11 @@ with more training sessions per arm) and writes under ``outputs/campaign_arms``:
   least R of the arm's healthy windows called healthy (``commission healthy_rate=R``, a quieter
   operating point) and writes ``commissioned_hr<R>/`` instead. With ``--normalisation M`` the
   commissioning also refits the z-scoring to the arm's healthy running (``commission
-  normalisation=M``) into ``commissioned_<M>/``. The ``validate`` step scores each leave-one-arm-out
-  model, before and after commissioning, on the unseen arm's training sessions
+  normalisation=M``) into ``commissioned_<M>/``. With ``--commissioning-minutes N`` it reads N
+  healthy minutes (``healthy_commissioning_seed940``, ``941``, ...; the corpus records them with
+  ``'corpus.healthy_commissioning.seeds=[940,941,942]'``) into ``commissioned<N>...``. The
+  ``validate`` step scores each leave-one-arm-out model, before and after commissioning, on the
+  unseen arm's training sessions
   (``eval_validation.json``): labelled running of that arm that no model here trained on, where a
   commissioning recipe is chosen before its held-out session is read.
 
@@ -50,6 +53,12 @@ CORPUS = Path("outputs/corpus/arms")
 OUT = Path("outputs/campaign_arms")
 ARMS = ("ur3e", "ur5e", "ur10e", "ur16e")
 HEALTHY_HOUR = ("healthy_hour_seed950", "healthy_hour_seed951", "healthy_hour_seed952")
+COMMISSIONING_SEED = 940  # the first ten healthy minutes; 941, 942, ... the next tens
+
+
+def commissioning_sessions(minutes: int) -> list[str]:
+    """The arm's healthy sessions (ten minutes each) a commissioning on ``minutes`` reads."""
+    return [f"healthy_commissioning_seed{COMMISSIONING_SEED + k}" for k in range(minutes // 10)]
 
 
 def train(sweep: Path, train: list[str], heldout: Path, args: argparse.Namespace, *extra: str):
@@ -103,24 +112,38 @@ def heldout_fingerprint(session: Path) -> str:
 
 
 def commissioned_dir(
-    run_dir: Path, healthy_rate: float | None = None, normalisation: str = "none"
+    run_dir: Path, healthy_rate: float | None = None, normalisation: str = "none", minutes: int = 10
 ) -> Path:
-    """Where ``run_dir``'s model commissioned at validation's healthy rate (``None``) or at
-    ``healthy_rate``, with the z-scoring refitted by ``normalisation`` (``none``: kept), lives."""
-    name = "commissioned" if healthy_rate is None else f"commissioned_hr{healthy_rate:g}"
+    """Where ``run_dir``'s model commissioned on ``minutes`` of healthy running at validation's
+    healthy rate (``None``) or at ``healthy_rate``, with the z-scoring refitted by
+    ``normalisation`` (``none``: kept), lives."""
+    name = "commissioned" if minutes == 10 else f"commissioned{minutes}"
+    name = name if healthy_rate is None else f"{name}_hr{healthy_rate:g}"
     return run_dir / (name if normalisation == "none" else f"{name}_{normalisation}")
 
 
 def commission_and_score(
-    run_dir: Path, arm_dir: Path, healthy_rate: float | None = None, normalisation: str = "none"
+    run_dir: Path,
+    arm_dir: Path,
+    healthy_rate: float | None = None,
+    normalisation: str = "none",
+    minutes: int = 10,
 ) -> None:
-    """Commission ``run_dir``'s model on the healthy ten minutes of ``arm_dir`` (one arm's corpus)
-    and score it on its held-out session."""
-    done = commissioned_dir(run_dir, healthy_rate, normalisation)
+    """Commission ``run_dir``'s model on ``minutes`` of healthy running of ``arm_dir`` (one arm's
+    corpus) and score it on its held-out session."""
+    done = commissioned_dir(run_dir, healthy_rate, normalisation, minutes)
     rate = [] if healthy_rate is None else [f"healthy_rate={healthy_rate:g}"]
+    sessions = [str(arm_dir / s) for s in commissioning_sessions(minutes)]
+    missing = [s for s in sessions if not Path(s).is_dir()]
+    if missing:
+        raise SystemExit(
+            f"{missing[0]}: not recorded (python -m robohealth_mj.corpus corpus=arms ... "
+            f"'corpus.healthy_commissioning.seeds=[940,941,...]', studies/arms/run_false_alarms.sh)"
+        )
+    healthy = sessions[0] if len(sessions) == 1 else f"[{','.join(sessions)}]"
     if not (done / "best.ckpt").is_file():
         run_step("robohealth_mj.commission", f"model={run_dir / 'best.ckpt'}",
-                 f"healthy={arm_dir / 'healthy_commissioning_seed940'}", f"out={done}",
+                 f"healthy={healthy}", f"out={done}",
                  f"normalisation={normalisation}", *rate)  # fmt: skip
     if not (done / "eval_heldout.json").is_file():
         score(done, arm_dir)
@@ -202,6 +225,14 @@ def main() -> None:
         help="commission with the z-scoring refitted to the arm's healthy running: sensors, "
         "shift or moments (commission normalisation=...), into commissioned_<M>/",
     )
+    parser.add_argument(
+        "--commissioning-minutes",
+        type=int,
+        default=10,
+        choices=(10, 20, 30),
+        help="commission on this many healthy minutes (healthy_commissioning_seed940, 941, ...), "
+        "into commissioned<N>/ where N is not 10",
+    )
     args = parser.parse_args()
     arms = args.arms.split(",")
     family = (args.family or args.arms).split(",")
@@ -230,9 +261,12 @@ def main() -> None:
             for run_dir in runs(sweep, variants):
                 if "rescore" in steps:
                     rescore(run_dir, root / arm)
-                done = commissioned_dir(run_dir, args.healthy_rate, args.normalisation)
+                minutes = args.commissioning_minutes
+                done = commissioned_dir(run_dir, args.healthy_rate, args.normalisation, minutes)
                 if "commission" in steps:
-                    commission_and_score(run_dir, root / arm, args.healthy_rate, args.normalisation)
+                    commission_and_score(
+                        run_dir, root / arm, args.healthy_rate, args.normalisation, minutes
+                    )
                 if "validate" in steps:
                     for scored in (run_dir, done):  # the commissioned model where it is
                         if (scored / "best.ckpt").is_file() and not (

@@ -2,7 +2,8 @@
 commissioning that keeps the training arms' (``studies/arms/campaign.py --normalisation M``).
 
     python studies/arms/normalisation.py [--out outputs/campaign_seven] [--sensing full]
-        [--seed 42]
+        [--seed 42] [--recipes commissioned_shift,commissioned30_hr0.99_shift,...]
+        [--recall struct_weaken]
 
 Per unseen arm and variant, each leave-one-arm-out model uncommissioned, commissioned as before
 (``none``), and commissioned with ``sensors``, ``shift`` and ``moments``
@@ -10,7 +11,9 @@ Per unseen arm and variant, each leave-one-arm-out model uncommissioned, commiss
 (validation: labelled running of that arm that no model here trained on) and on its held-out
 session, and the commissioned network's false alarms over the arm's healthy hour where they
 were counted. The recipe is chosen on validation alone, per variant and over all: the mean of
-accuracy and localisation over the unseen arms.
+accuracy and localisation over the unseen arms. ``--recipes`` sets other commissioned
+directories side by side instead (``campaign.py``'s names: a healthy rate, more minutes), and
+``--recall C`` adds fault class C's recall on both splits.
 """
 
 from __future__ import annotations
@@ -35,12 +38,14 @@ RECIPES = {  # what each recipe's scores are read from, under a run
 TICK_S = 0.05
 
 
-def _scores(run: Path, split: str) -> tuple[float, float] | None:
+def _scores(run: Path, split: str, recall: str | None = None) -> tuple[float, ...] | None:
+    """Accuracy and localisation of ``run`` on ``split`` (and class ``recall``'s recall)."""
     path = run / f"eval_{split}.json"
     if not path.is_file():
         return None
     m = json.loads(path.read_text())["metrics"]
-    return m["accuracy"], m["localisation_accuracy"]
+    extra = (m["per_class"][recall]["recall"],) if recall else ()
+    return m["accuracy"], m["localisation_accuracy"], *extra
 
 
 def _false_alarms(done: Path) -> str:
@@ -51,7 +56,9 @@ def _false_alarms(done: Path) -> str:
     return f"{sum(a['false_alarms'] for a in alarms) / hours:.2f}"
 
 
-def collect(root: Path, seed: int) -> list[dict]:
+def collect(
+    root: Path, seed: int, recipes: dict[str, str] = RECIPES, recall: str | None = None
+) -> list[dict]:
     """One row per (unseen arm, variant, recipe) of seed ``seed``'s models with validation and
     held-out scores."""
     rows = []
@@ -59,9 +66,9 @@ def collect(root: Path, seed: int) -> list[dict]:
         if not (run / "best.ckpt").is_file():
             continue
         arm, variant = run.relative_to(root).parts[0], run.parts[-3]
-        for recipe, sub in RECIPES.items():
+        for recipe, sub in recipes.items():
             done = run / sub
-            val, held = _scores(done, "validation"), _scores(done, "heldout")
+            val, held = _scores(done, "validation", recall), _scores(done, "heldout", recall)
             if val is None or held is None:
                 continue
             rows.append({"arm": arm, "variant": variant, "recipe": recipe, "val": val,
@@ -69,18 +76,19 @@ def collect(root: Path, seed: int) -> list[dict]:
     return rows
 
 
-def table(rows: list[dict]) -> str:
+def table(rows: list[dict], recall: str | None = None, what: str = "normalisation") -> str:
+    extra = [f"validation {recall} recall", f"held-out {recall} recall"] if recall else []
     lines = heading(
-        "Leave-one-arm-out, the commissioning's normalisation (unseen arm)",
+        f"Leave-one-arm-out, the commissioning's {what} (unseen arm)",
         ["unseen arm", "variant", "recipe", "validation acc.", "validation loc.",
-         "held-out acc.", "held-out loc.", "false alarms / healthy h"],
+         "held-out acc.", "held-out loc.", *extra, "false alarms / healthy h"],
     )  # fmt: skip
     for r in rows:
-        lines.append(
-            f"| {r['arm']} | {r['variant']} | {r['recipe']} | {r['val'][0]:.3f} | "
-            f"{r['val'][1]:.3f} | {r['heldout'][0]:.3f} | {r['heldout'][1]:.3f} | "
-            f"{r['false_alarms']} |"
-        )
+        recalls = (r["val"][2], r["heldout"][2]) if extra else ()
+        cells = [*r["val"][:2], *r["heldout"][:2], *recalls]
+        scores = " | ".join(f"{v:.3f}" for v in cells)
+        run = f"| {r['arm']} | {r['variant']} | {r['recipe']} |"
+        lines.append(f"{run} {scores} | {r['false_alarms']} |")
     return "\n".join(lines) + "\n"
 
 
@@ -94,10 +102,10 @@ def _complete(rows: list[dict]) -> set[tuple[str, str]]:
     return {key for key, got in recipes.items() if got == found}
 
 
-def choice(rows: list[dict]) -> str:
+def choice(rows: list[dict], recipes: dict[str, str] = RECIPES) -> str:
     """Each recipe's mean over the unseen arms, per variant and over all variants, and the pick
     of each: the best validation mean of accuracy and localisation."""
-    complete, found = _complete(rows), [q for q in RECIPES if q in {r["recipe"] for r in rows}]
+    complete, found = _complete(rows), [q for q in recipes if q in {r["recipe"] for r in rows}]
     lines = heading(
         f"Means over the unseen arms ({len(complete)} models); the pick is validation's",
         ["variant", "recipe", "validation acc.", "validation loc.", "validation mean",
@@ -111,8 +119,8 @@ def choice(rows: list[dict]) -> str:
                 if r["recipe"] == recipe and (r["arm"], r["variant"]) in complete
                 and variant in ("all", r["variant"])
             ]  # fmt: skip
-            val = np.mean([r["val"] for r in got], axis=0)
-            held = np.mean([r["heldout"] for r in got], axis=0)
+            val = np.mean([r["val"][:2] for r in got], axis=0)
+            held = np.mean([r["heldout"][:2] for r in got], axis=0)
             means[recipe] = float(val.mean())
             cells[recipe] = (f"{val[0]:.3f} | {val[1]:.3f} | {val.mean():.3f} | {held[0]:.3f} | "
                              f"{held[1]:.3f}")  # fmt: skip
@@ -128,11 +136,15 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=ROOT / "outputs" / "campaign_seven")
     parser.add_argument("--sensing", default="full")
     parser.add_argument("--seed", type=int, default=42)
+    parser.add_argument("--recipes", help="commissioned directories to compare, comma-separated")
+    parser.add_argument("--recall", help="a fault class whose recall to add, e.g. struct_weaken")
     args = parser.parse_args()
-    rows = collect(args.out / args.sensing / "loao", args.seed)
+    recipes = {r: r for r in args.recipes.split(",")} if args.recipes else RECIPES
+    rows = collect(args.out / args.sensing / "loao", args.seed, recipes, args.recall)
     if not rows:
         raise SystemExit(f"no scored runs under {args.out / args.sensing / 'loao'}")
-    print(table(rows) + "\n" + choice(rows))
+    what = "recipes" if args.recipes else "normalisation"
+    print(table(rows, args.recall, what) + "\n" + choice(rows, recipes))
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 """The cross-arm table from the campaign's evaluations (``studies/arms/campaign.py``).
 
     python studies/arms/summarise.py [--sensing full] [--out DIR] [--seeds 42]
-        [--healthy-rate 0.99] [--against DIR] [--own DIR]
+        [--healthy-rate 0.99] [--normalisation shift] [--commissioning-minutes 30]
+        [--against DIR] [--own DIR]
 
 One row per held-out arm and variant: the arm's own model; the leave-one-arm-out model (trained
 with ``transfer=true`` on the family's other arms) before and after commissioning on ten minutes
@@ -12,7 +13,8 @@ exceeds the larger seed std. Also writes ``studies/arms/results/results_<sensing
 ``--out``, ``results_<its name>_<sensing>.csv``). ``--healthy-rate R`` reads the models
 commissioned at that healthy rate (``campaign.py --healthy-rate R``) in place of validation's.
 ``--normalisation M`` reads the models commissioned with that normalisation
-(``campaign.py --normalisation M``). ``--against DIR`` adds each model beside the same model of
+(``campaign.py --normalisation M``), ``--commissioning-minutes N`` those commissioned on N
+healthy minutes. ``--against DIR`` adds each model beside the same model of
 another campaign root (e.g. one trained on fewer sessions per arm): what the recipe changed, per
 arm, variant and stage.
 """
@@ -248,6 +250,12 @@ def main() -> None:
         help="the models commissioned with this normalisation (campaign.py --normalisation M)",
     )
     parser.add_argument(
+        "--commissioning-minutes",
+        type=int,
+        default=10,
+        help="the models commissioned on this many healthy minutes (campaign.py, same option)",
+    )
+    parser.add_argument(
         "--against", type=Path, help="another campaign root to set each model beside"
     )
     parser.add_argument(
@@ -259,13 +267,15 @@ def main() -> None:
     args = parser.parse_args()
     seeds = set(args.seeds.split(",")) if args.seeds else None
     rate = args.healthy_rate
-    commissioned = commissioned_dir(Path(), rate, args.normalisation).name
+    minutes = args.commissioning_minutes
+    commissioned = commissioned_dir(Path(), rate, args.normalisation, minutes).name
     table = collect(args.sensing, args.out, seeds, commissioned, args.own)
     if not table:
         raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
     RESULTS.mkdir(parents=True, exist_ok=True)
     recipe = "" if args.out.resolve() == OUT.resolve() else f"{args.out.name}_"
     recipe += f"seeds{'_'.join(sorted(seeds))}_" if seeds else ""
+    recipe += f"{minutes}min_" if minutes != 10 else ""
     recipe += f"hr{rate:g}_" if rate is not None else ""
     recipe += f"{args.normalisation}_" if args.normalisation != "none" else ""
     write_csv(table, RESULTS / f"results_{recipe}{args.sensing}.csv")
