@@ -5,9 +5,10 @@
 # seeds 941-942) at validation's operating point and at healthy_rate 0.99, each scored on the
 # iiwa's held-out session and on its training sessions (validation: the recipe is chosen there),
 # and their alarms counted over the healthy hour. Then the family's leave-one-arm-out after the
-# mount and curriculum fixes (the six UR arms beside the other seven-joint arms), seed 42.
-# About 40 minutes for the first part, 40 minutes an unseen arm for the second, on 2 cores.
-# Tables: studies/arms/README.md, "The iiwa's false alarms, located".
+# mount and curriculum fixes (the six UR arms beside the other seven-joint arms), seed 42, and
+# the same commissioning recipes on its iiwa, xArm7 and Gen3 models. About 40 minutes for the first
+# part, 25 minutes an unseen arm for the second, on 2 cores. Tables: studies/arms/README.md,
+# "The iiwa's false alarms, located" and "The whole family, after the fixes".
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 PY=${PY:-.venv/bin/python}
@@ -56,13 +57,22 @@ for arm in ${FAMILY_ARMS:-iiwa14 xarm7 fr3 gen3}; do
   wait
   $F --variants mlp,anomaly_residual --steps commission,alarms --normalisation shift
 done
-# the family's iiwa networks commissioned on 30 minutes at healthy rate 0.99 as well
-F="$PY studies/arms/campaign.py --arms iiwa14 --family ur5e,ur3e,ur10e,ur16e,ur20,ur30,$SEVEN --stages loao --seeds 42 --out outputs/campaign_family_fixed --variants mlp,anomaly_residual --normalisation shift"
-$F --commissioning-minutes 30 --steps commission,alarms,validate --healthy-rate 0.99
-$F --steps validate
+# the family's iiwa, xArm7 and Gen3 networks commissioned on 30 minutes as well, at validation's rate
+# and at 0.99, each scored on validation (the arm's training sessions)
+for arm in xarm7 gen3; do
+  $PY -m robohealth_mj.corpus corpus=arms out_dir=outputs/corpus/arms/$arm progress=false \
+    "record_overrides=[\"arm=$arm\"]" '~corpus.probe_payload_high' \
+    'corpus.healthy_commissioning.seeds=[940,941,942]'
+done
+for arm in iiwa14 xarm7 gen3; do
+  F="$PY studies/arms/campaign.py --arms $arm --family ur5e,ur3e,ur10e,ur16e,ur20,ur30,$SEVEN --stages loao --seeds 42 --out outputs/campaign_family_fixed --variants mlp,anomaly_residual --normalisation shift"
+  $F --commissioning-minutes 30 --steps commission,alarms,validate
+  $F --commissioning-minutes 30 --steps commission,alarms,validate --healthy-rate 0.99
+  $F --steps validate
+done
 $PY studies/arms/normalisation.py --out outputs/campaign_family_fixed \
-  --recipes commissioned_shift,commissioned30_hr0.99_shift --recall struct_weaken \
-  > studies/arms/results/family_fixed_iiwa_recipes.md
+  --recipes commissioned_shift,commissioned30_shift,commissioned30_hr0.99_shift \
+  --recall struct_weaken > studies/arms/results/family_fixed_recipes.md
 $PY studies/arms/summarise.py --out outputs/campaign_family_fixed --own outputs/campaign_seven \
   --normalisation shift > studies/arms/results/family_fixed_shift.md
 $PY studies/arms/summarise.py --out outputs/campaign_family_fixed --own outputs/campaign_seven \
