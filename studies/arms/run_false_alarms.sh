@@ -50,12 +50,8 @@ for arm in ur3e ur10e ur16e ur20 ur30; do
     '~corpus.healthy_hour' '~corpus.healthy_commissioning'
 done
 for arm in ${FAMILY_ARMS:-iiwa14 xarm7 fr3 gen3}; do
-  F="$PY studies/arms/campaign.py --arms $arm --family ur5e,ur3e,ur10e,ur16e,ur20,ur30,$SEVEN --stages loao --seeds 42 --out outputs/campaign_family_fixed"
-  ($F --variants gbdt --override model.severity=false --steps train,rescore,commission &&
-    $F --variants mlp --epochs 10 --steps train,rescore) &
-  $F --variants anomaly_residual --epochs 10 --steps train,rescore
-  wait
-  $F --variants mlp,anomaly_residual --steps commission,alarms --normalisation shift
+  PY=$PY bash studies/arms/loao_one_arm.sh $arm ur5e,ur3e,ur10e,ur16e,ur20,ur30,$SEVEN \
+    outputs/campaign_family_fixed
 done
 # the family's iiwa, xArm7 and Gen3 networks commissioned on 30 minutes as well, at validation's rate
 # and at 0.99, each scored on validation (the arm's training sessions)

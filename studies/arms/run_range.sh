@@ -24,12 +24,7 @@ C="$PY studies/arms/campaign.py --arms fr3 --stages own --steps train --seeds 42
 $C --variants anomaly_residual --epochs 10
 wait
 for arm in ${SEVEN//,/ }; do
-  L="$PY studies/arms/campaign.py --arms $arm --family $SEVEN --stages loao --seeds 42 --out outputs/campaign_seven_limit"
-  ($L --variants gbdt --override model.severity=false --steps train,rescore,commission &&
-    $L --variants mlp --epochs 10 --steps train,rescore) &
-  $L --variants anomaly_residual --epochs 10 --steps train,rescore
-  wait
-  $L --variants mlp,anomaly_residual --steps commission,alarms --normalisation shift
+  PY=$PY bash studies/arms/loao_one_arm.sh $arm $SEVEN outputs/campaign_seven_limit
 done
 # the iiwa's networks at the quieter operating point (at least 99 % of its healthy windows healthy)
 $PY studies/arms/campaign.py --arms iiwa14 --family $SEVEN --stages loao --seeds 42 \
