@@ -24,6 +24,7 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
+from campaign import HEALTHY_HOUR, commissioning_sessions  # this folder's campaign: the sessions
 from omegaconf import OmegaConf
 
 from robohealth_mj import schema
@@ -35,7 +36,6 @@ from robohealth_mj.runtime.alarms import AlarmBank, AlarmPolicy
 from robohealth_mj.runtime.evidence import EvidencePolicy
 from robohealth_mj.sim.curriculum import Curriculum, Segment
 
-HOUR = ("healthy_hour_seed950", "healthy_hour_seed951", "healthy_hour_seed952")
 TICK_S = 0.05
 
 
@@ -88,8 +88,8 @@ def longest_runs(decisions: list[Decisions], fault: int, min_confidence: float) 
 def report(run: Path, arm: str, corpus: Path, minutes: int = 10) -> None:
     cfg = compose_config("monitor")
     policy, evidence = AlarmPolicy(**cfg.alarm), EvidencePolicy(**cfg.evidence)
-    commissioning = tuple(f"healthy_commissioning_seed{940 + k}" for k in range(minutes // 10))
-    sessions = (*commissioning, *HOUR)
+    commissioning = tuple(commissioning_sessions(minutes))
+    sessions = (*commissioning, *HEALTHY_HOUR)
     files = [corpus / arm / session / "graphs.jsonl" for session in sessions]
     decisions = replay_many(run / "model.onnx", files)
     classes = schema.FAULT_CLASSES
@@ -126,7 +126,7 @@ def report(run: Path, arm: str, corpus: Path, minutes: int = 10) -> None:
     for kind in sorted(set().union(*visits.values())):
         ten = (sum(kinds[s][kind] for s in commissioning),
                sum(visits[s][kind] for s in commissioning))  # fmt: skip
-        hour = sum(kinds[s][kind] for s in HOUR), sum(visits[s][kind] for s in HOUR)
+        hour = sum(kinds[s][kind] for s in HEALTHY_HOUR), sum(visits[s][kind] for s in HEALTHY_HOUR)
         cells = [f"{v} of {n} ({100 * v / n:.2f} %)" if n else "–" for v, n in (ten, hour)]
         print(f"| {kind} | {cells[0]} | {cells[1]} |")
     print()
