@@ -133,15 +133,16 @@ def commission_and_score(
     corpus) and score it on its held-out session."""
     done = commissioned_dir(run_dir, healthy_rate, normalisation, minutes)
     rate = [] if healthy_rate is None else [f"healthy_rate={healthy_rate:g}"]
-    sessions = [str(arm_dir / s) for s in commissioning_sessions(minutes)]
-    missing = [s for s in sessions if not Path(s).is_dir()]
-    if missing:
-        raise SystemExit(
-            f"{missing[0]}: not recorded (python -m robohealth_mj.corpus corpus=arms ... "
-            f"'corpus.healthy_commissioning.seeds=[940,941,...]', studies/arms/run_false_alarms.sh)"
-        )
-    healthy = sessions[0] if len(sessions) == 1 else f"[{','.join(sessions)}]"
     if not (done / "best.ckpt").is_file():
+        sessions = [str(arm_dir / s) for s in commissioning_sessions(minutes)]
+        missing = [s for s in sessions if not Path(s).is_dir()]
+        if missing:
+            raise SystemExit(
+                f"{missing[0]}: not recorded (python -m robohealth_mj.corpus corpus=arms ... "
+                f"'corpus.healthy_commissioning.seeds=[940,941,...]', "
+                "studies/arms/run_false_alarms.sh)"
+            )
+        healthy = sessions[0] if len(sessions) == 1 else f"[{','.join(sessions)}]"
         run_step("robohealth_mj.commission", f"model={run_dir / 'best.ckpt'}",
                  f"healthy={healthy}", f"out={done}",
                  f"normalisation={normalisation}", *rate)  # fmt: skip

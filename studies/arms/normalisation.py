@@ -38,14 +38,9 @@ RECIPES = {  # what each recipe's scores are read from, under a run
 TICK_S = 0.05
 
 
-def _scores(run: Path, split: str, recall: str | None = None) -> tuple[float, ...] | None:
-    """Accuracy and localisation of ``run`` on ``split`` (and class ``recall``'s recall)."""
+def _metrics(run: Path, split: str) -> dict | None:
     path = run / f"eval_{split}.json"
-    if not path.is_file():
-        return None
-    m = json.loads(path.read_text())["metrics"]
-    extra = (m["per_class"][recall]["recall"],) if recall else ()
-    return m["accuracy"], m["localisation_accuracy"], *extra
+    return json.loads(path.read_text())["metrics"] if path.is_file() else None
 
 
 def _false_alarms(done: Path) -> str:
@@ -68,11 +63,15 @@ def collect(
         arm, variant = run.relative_to(root).parts[0], run.parts[-3]
         for recipe, sub in recipes.items():
             done = run / sub
-            val, held = _scores(done, "validation", recall), _scores(done, "heldout", recall)
+            val, held = _metrics(done, "validation"), _metrics(done, "heldout")
             if val is None or held is None:
                 continue
-            rows.append({"arm": arm, "variant": variant, "recipe": recipe, "val": val,
-                         "heldout": held, "false_alarms": _false_alarms(done)})  # fmt: skip
+            scores = {split: (m["accuracy"], m["localisation_accuracy"])
+                      for split, m in (("val", val), ("heldout", held))}  # fmt: skip
+            if recall:  # class ``recall``'s recall on both splits
+                scores["recall"] = tuple(m["per_class"][recall]["recall"] for m in (val, held))
+            rows.append({"arm": arm, "variant": variant, "recipe": recipe, **scores,
+                         "false_alarms": _false_alarms(done)})  # fmt: skip
     return rows
 
 
@@ -84,8 +83,7 @@ def table(rows: list[dict], recall: str | None = None, what: str = "normalisatio
          "held-out acc.", "held-out loc.", *extra, "false alarms / healthy h"],
     )  # fmt: skip
     for r in rows:
-        recalls = (r["val"][2], r["heldout"][2]) if extra else ()
-        cells = [*r["val"][:2], *r["heldout"][:2], *recalls]
+        cells = [*r["val"], *r["heldout"], *r.get("recall", ())]
         scores = " | ".join(f"{v:.3f}" for v in cells)
         run = f"| {r['arm']} | {r['variant']} | {r['recipe']} |"
         lines.append(f"{run} {scores} | {r['false_alarms']} |")
@@ -119,8 +117,8 @@ def choice(rows: list[dict], recipes: dict[str, str] = RECIPES) -> str:
                 if r["recipe"] == recipe and (r["arm"], r["variant"]) in complete
                 and variant in ("all", r["variant"])
             ]  # fmt: skip
-            val = np.mean([r["val"][:2] for r in got], axis=0)
-            held = np.mean([r["heldout"][:2] for r in got], axis=0)
+            val = np.mean([r["val"] for r in got], axis=0)
+            held = np.mean([r["heldout"] for r in got], axis=0)
             means[recipe] = float(val.mean())
             cells[recipe] = (f"{val[0]:.3f} | {val[1]:.3f} | {val.mean():.3f} | {held[0]:.3f} | "
                              f"{held[1]:.3f}")  # fmt: skip
