@@ -222,9 +222,14 @@ def test_a_research_script_imports_only_what_exists(script):
         sibling = script.parent / f"{module}.py"
         if sibling.is_file():  # a helper beside the script in its study's folder
             body = ast.parse(sibling.read_text()).body
-            defined = {n.name for n in body if hasattr(n, "name")} | {
-                a.asname or a.name for n in body if isinstance(n, ast.ImportFrom) for a in n.names
-            }  # what it defines or imports for its scripts
+            assigned = (n.targets if isinstance(n, ast.Assign) else [n.target]
+                        for n in body if isinstance(n, ast.Assign | ast.AnnAssign))  # fmt: skip
+            imported = (n.names for n in body if isinstance(n, ast.ImportFrom))
+            defined = (
+                {n.name for n in body if hasattr(n, "name")}
+                | {a.asname or a.name for names in imported for a in names}
+                | {t.id for targets in assigned for t in targets if isinstance(t, ast.Name)}
+            )  # what it defines, imports or assigns (its constants) for its scripts
             assert set(names) <= defined, f"{where}: {sibling.name} has no {set(names) - defined}"
             continue
         if not module.startswith("robohealth_mj"):
