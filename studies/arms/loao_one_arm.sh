@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
-# One unseen arm's leave-one-arm-out at seed 42: gbdt, mlp and the headline trained on the other
-# arms of FAMILY (two jobs of one thread), scored on ARM's held-out session, then commissioned by
-# validation's recipe (gbdt: none; the networks: shift) on its ten healthy minutes, and the
-# networks' alarms counted over its healthy hour. Used by run_range.sh and run_false_alarms.sh.
+# One unseen arm's leave-one-arm-out at seed 42 (or at the seeds SEEDS names, e.g. SEEDS=43,44):
+# gbdt, mlp and the headline trained on the other arms of FAMILY (two jobs of one thread), scored
+# on ARM's held-out session, then commissioned by validation's recipe (gbdt: none; the networks:
+# shift) on its ten healthy minutes, and the networks' alarms counted over its healthy hour. Used
+# by run_range.sh, run_false_alarms.sh and run_family_seeds.sh.
 #   bash studies/arms/loao_one_arm.sh ARM FAMILY OUT
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 PY=${PY:-.venv/bin/python}
 arm=$1 family=$2 out=$3
-L="$PY studies/arms/campaign.py --arms $arm --family $family --stages loao --seeds 42 --out $out"
+L="$PY studies/arms/campaign.py --arms $arm --family $family --stages loao --seeds ${SEEDS:-42} --out $out"
 ($L --variants gbdt --override model.severity=false --steps train,rescore,commission &&
   $L --variants mlp --epochs 10 --steps train,rescore) &
 $L --variants anomaly_residual --epochs 10 --steps train,rescore

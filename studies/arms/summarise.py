@@ -2,14 +2,16 @@
 
     python studies/arms/summarise.py [--sensing full] [--out DIR] [--seeds 42]
         [--healthy-rate 0.99] [--normalisation shift] [--commissioning-minutes 30]
-        [--against DIR] [--own DIR]
+        [--against DIR] [--own DIR] [--baseline-normalisation none]
 
 One row per held-out arm and variant: the arm's own model; the leave-one-arm-out model (trained
 with ``transfer=true`` on the family's other arms) before and after commissioning on ten minutes
 of the arm's healthy running; the commissioned network's false alarms over the arm's healthy
 hour (the monitor's replay with its default alarm policy). Mean ± std over the seeds found.
 Then each network against ``gbdt`` after commissioning: ahead when the difference of the means
-exceeds the larger seed std. Also writes ``studies/arms/results/results_<sensing>.csv`` (for another
+exceeds the larger seed std (``--baseline-normalisation M``: ``gbdt``'s models commissioned with M,
+each model by its own validation's recipe, e.g. ``shift`` for the networks and ``none`` for the
+trees). Also writes ``studies/arms/results/results_<sensing>.csv`` (for another
 ``--out``, ``results_<its name>_<sensing>.csv``). ``--healthy-rate R`` reads the models
 commissioned at that healthy rate (``campaign.py --healthy-rate R``) in place of validation's.
 ``--normalisation M`` reads the models commissioned with that normalisation
@@ -170,9 +172,12 @@ def validation(table: dict, sensing: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def verdict(table: dict, sensing: str, baseline: str = "gbdt") -> str:
+def verdict(
+    table: dict, sensing: str, baseline: str = "gbdt", baseline_table: dict | None = None
+) -> str:
     """The issue's question in one table: each network against the trees on the unseen arm
-    after commissioning, the difference of the means beside the larger of the two seed stds."""
+    after commissioning, the difference of the means beside the larger of the two seed stds
+    (the trees' rows from ``baseline_table`` where they were commissioned another way)."""
     lines = heading(
         f"The graph against `{baseline}` on the unseen arm after commissioning, "
         f"sensing = {sensing}",
@@ -180,7 +185,7 @@ def verdict(table: dict, sensing: str, baseline: str = "gbdt") -> str:
          f"Δ loc. vs {baseline}", "larger std", "ahead"],
     )  # fmt: skip
     for arm in ARMS:
-        base = table.get((arm, baseline))
+        base = (baseline_table or table).get((arm, baseline))
         for variant in sorted(v for a, v in table if a == arm and v != baseline):
             cells = []
             for k in ("acc", "loc"):
@@ -189,6 +194,9 @@ def verdict(table: dict, sensing: str, baseline: str = "gbdt") -> str:
                     cells += ["–", "–", "–"]
                     continue
                 gap, spread = np.mean(ours) - np.mean(theirs), max(np.std(ours), np.std(theirs))
+                if min(len(ours), len(theirs)) < 2:  # one seed has no spread to beat
+                    cells += [f"{gap:+.3f}", "one seed", "–"]
+                    continue
                 cells += [f"{gap:+.3f}", f"{spread:.3f}", "yes" if gap > spread else "no"]
             lines.append(f"| {arm} | {variant} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
@@ -259,6 +267,11 @@ def main() -> None:
         "--against", type=Path, help="another campaign root to set each model beside"
     )
     parser.add_argument(
+        "--baseline-normalisation",
+        choices=MATCHES,
+        help="compare against gbdt commissioned with this normalisation (default: --normalisation)",
+    )
+    parser.add_argument(
         "--own",
         type=Path,
         help="the campaign root of the arms' own models (default --out), e.g. the seven-joint "
@@ -280,8 +293,15 @@ def main() -> None:
     recipe += f"{args.normalisation}_" if args.normalisation != "none" else ""
     write_csv(table, RESULTS / f"results_{recipe}{args.sensing}.csv")
     print(markdown(table, args.sensing))
-    if any(v == "gbdt" for _, v in table):
-        print(verdict(table, args.sensing))
+    base_norm = args.baseline_normalisation or args.normalisation
+    base_dir = commissioned_dir(Path(), rate, base_norm, minutes).name
+    trees = (
+        table
+        if base_dir == commissioned
+        else collect(args.sensing, args.out, seeds, base_dir, args.own)
+    )
+    if any(v == "gbdt" for _, v in trees):
+        print(verdict(table, args.sensing, baseline_table=trees))
     print(validation(table, args.sensing))
     if args.against is not None:
         base = collect(args.sensing, args.against, seeds, commissioned)
