@@ -9,7 +9,8 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 PY=${PY:-.venv/bin/python}
 arm=$1 family=$2 out=$3
-L="$PY studies/arms/campaign.py --arms $arm --family $family --stages loao --seeds ${SEEDS:-42} --out $out"
+L="$PY studies/arms/campaign.py --arms $arm --family $family --stages loao --out $out"
+L="$L --seeds ${SEEDS:-42}"
 ($L --variants gbdt --override model.severity=false --steps train,rescore,commission &&
   $L --variants mlp --epochs 10 --steps train,rescore) &
 $L --variants anomaly_residual --epochs 10 --steps train,rescore

@@ -9,15 +9,14 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 PY=${PY:-.venv/bin/python}
 ARMS=${ARMS:-fr3,xarm7}
-SEVEN=fr3,iiwa14,gen3,xarm7
+FAMILY=ur5e,ur3e,ur10e,ur16e,ur20,ur30,fr3,iiwa14,gen3,xarm7
 C="$PY studies/arms/campaign.py --arms ur5e,fr3,iiwa14,gen3,xarm7 --stages own --steps train"
 C="$C --seeds 42,43,44 --out outputs/campaign_seven"
 ($C --variants gbdt --override model.severity=false && $C --variants mlp --epochs 10) &
 $C --variants anomaly_residual --epochs 10
 wait
 for arm in ${ARMS//,/ }; do
-  SEEDS=43,44 PY=$PY bash studies/arms/loao_one_arm.sh $arm ur5e,ur3e,ur10e,ur16e,ur20,ur30,$SEVEN \
-    outputs/campaign_family_fixed
+  SEEDS=43,44 PY=$PY bash studies/arms/loao_one_arm.sh $arm $FAMILY outputs/campaign_family_fixed
 done
 $PY studies/arms/summarise.py --out outputs/campaign_family_fixed --own outputs/campaign_seven \
   --normalisation shift --baseline-normalisation none > studies/arms/results/family_seeds_shift.md
@@ -26,8 +25,8 @@ $PY studies/arms/summarise.py --out outputs/campaign_family_fixed --own outputs/
 # The xArm7's models at seeds 43 and 44 on thirty commissioning minutes too, and every model
 # scored on the arm's training sessions (validation), to see whether the longer commissioning
 # closes its gap.
-F="$PY studies/arms/campaign.py --arms xarm7 --family ur5e,ur3e,ur10e,ur16e,ur20,ur30,$SEVEN"
-F="$F --stages loao --seeds 43,44 --out outputs/campaign_family_fixed --variants mlp,anomaly_residual"
+F="$PY studies/arms/campaign.py --arms xarm7 --family $FAMILY --stages loao"
+F="$F --seeds 43,44 --out outputs/campaign_family_fixed --variants mlp,anomaly_residual"
 $F --normalisation shift --commissioning-minutes 30 --steps commission,alarms,validate
 $F --normalisation shift --steps validate
 $PY studies/arms/summarise.py --out outputs/campaign_family_fixed --own outputs/campaign_seven \
