@@ -6,6 +6,7 @@ commissioning, and false alarms on the unseen arm's healthy hour.
         [--stages own,loao]
         [--steps train,rescore,commission,alarms,validate] [--healthy-rate 0.99]
         [--normalisation sensors|shift|moments] [--commissioning-minutes 10|20|30]
+        [--unseen-sessions N]
 
 Reads the per-arm corpora ``outputs/corpus/arms/<arm>`` (``python -m robohealth_mj.corpus
 corpus=arms ...``, see ``studies/arms/run.sh``; ``--corpus`` names another root, e.g. one
@@ -26,7 +27,10 @@ with more training sessions per arm) and writes under ``outputs/campaign_arms``:
   ``validate`` step scores each leave-one-arm-out model, before and after commissioning, on the
   unseen arm's training sessions
   (``eval_validation.json``): labelled running of that arm that no model here trained on, where a
-  commissioning recipe is chosen before its held-out session is read.
+  commissioning recipe is chosen before its held-out session is read. With ``--unseen-sessions
+  N`` the first N of the unseen arm's training sessions join the family's (what a few of the
+  arm's own simulated sessions buy over leave-one-arm-out; give it its own ``--out``), and
+  ``validate`` scores on the arm's other training sessions.
 
 Every step skips what is done, so an interrupted campaign resumes. Training runs through the
 package's own entry points (Hydra multirun, two jobs of one thread).
@@ -150,10 +154,14 @@ def commission_and_score(
         score(done, arm_dir)
 
 
-def score(run_dir: Path, arm_dir: Path, split: str = "heldout") -> None:
+def score(
+    run_dir: Path, arm_dir: Path, split: str = "heldout", sessions: list[str] | None = None
+) -> None:
     """``run_dir``'s checkpoint on the held-out session of ``arm_dir`` as ``eval_heldout.json``,
-    or (``split="validation"``) on its training sessions as ``eval_validation.json``."""
+    or (``split="validation"``) on its training sessions (``sessions``, default all of them) as
+    ``eval_validation.json``."""
     data = arm_dir / "heldout_seed900" if split == "heldout" else f"{arm_dir}/train_*"
+    data = f"[{','.join(sessions)}]" if split != "heldout" and sessions else data
     run_step("robohealth_mj.evaluate", f"ckpt={run_dir / 'best.ckpt'}",
              f"data={data}", f"out={run_dir / f'eval_{split}'}")  # fmt: skip
 
@@ -234,6 +242,14 @@ def main() -> None:
         help="commission on this many healthy minutes (healthy_commissioning_seed940, 941, ...), "
         "into commissioned<N>/ where N is not 10",
     )
+    parser.add_argument(
+        "--unseen-sessions",
+        type=int,
+        default=0,
+        help="the first N of the unseen arm's training sessions join the family's (default 0: "
+        "leave-one-arm-out proper); validate scores on its other training sessions; give the "
+        "campaign its own --out",
+    )
     args = parser.parse_args()
     arms = args.arms.split(",")
     family = (args.family or args.arms).split(",")
@@ -255,7 +271,9 @@ def main() -> None:
             for run_dir in runs(own, variants):
                 rescore(run_dir, root / arm)
         if "loao" in stages:
-            others = [f"{root}/{a}/train_*" for a in family if a != arm]
+            sessions = sorted(str(p) for p in (root / arm).glob("train_*"))
+            seen, unseen = sessions[: args.unseen_sessions], sessions[args.unseen_sessions :]
+            others = [f"{root}/{a}/train_*" for a in family if a != arm] + seen
             sweep = args.out / args.sensing / "loao" / arm
             if "train" in steps:
                 train(sweep, others, heldout, args, "transfer=true")
@@ -273,9 +291,11 @@ def main() -> None:
                         if (scored / "best.ckpt").is_file() and not (
                             scored / "eval_validation.json"
                         ).is_file():
-                            score(scored, root / arm, "validation")
-                if "alarms" in steps and (done / "model.onnx").is_file():
-                    healthy_alarms(done, root / arm)  # networks: a streaming runtime
+                            score(scored, root / arm, "validation", unseen)
+                if "alarms" in steps:  # networks: a streaming runtime; the model as trained
+                    for scored in (run_dir, done):  # too where it was exported
+                        if (scored / "model.onnx").is_file():
+                            healthy_alarms(scored, root / arm)
 
 
 if __name__ == "__main__":

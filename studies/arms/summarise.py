@@ -277,11 +277,19 @@ def main() -> None:
         help="the campaign root of the arms' own models (default --out), e.g. the seven-joint "
         "campaign's for the family's leave-one-arm-out",
     )
+    parser.add_argument(
+        "--as-trained",
+        action="store_true",
+        help="the unseen arm's models as trained, not commissioned, in the commissioned columns "
+        "(with their alarms where campaign.py counted them): for a campaign whose training saw "
+        "some of the arm's own sessions (campaign.py --unseen-sessions)",
+    )
     args = parser.parse_args()
     seeds = set(args.seeds.split(",")) if args.seeds else None
     rate = args.healthy_rate
     minutes = args.commissioning_minutes
     commissioned = commissioned_dir(Path(), rate, args.normalisation, minutes).name
+    commissioned = "." if args.as_trained else commissioned
     table = collect(args.sensing, args.out, seeds, commissioned, args.own)
     if not table:
         raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
@@ -291,10 +299,11 @@ def main() -> None:
     recipe += f"{minutes}min_" if minutes != 10 else ""
     recipe += f"hr{rate:g}_" if rate is not None else ""
     recipe += f"{args.normalisation}_" if args.normalisation != "none" else ""
+    recipe += "as_trained_" if args.as_trained else ""
     write_csv(table, RESULTS / f"results_{recipe}{args.sensing}.csv")
     print(markdown(table, args.sensing))
     base_norm = args.baseline_normalisation or args.normalisation
-    base_dir = commissioned_dir(Path(), rate, base_norm, minutes).name
+    base_dir = "." if args.as_trained else commissioned_dir(Path(), rate, base_norm, minutes).name
     trees = (
         table
         if base_dir == commissioned

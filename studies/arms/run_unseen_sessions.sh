@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Issue 65: what two of the unseen arm's own simulated sessions buy over the family's
+# leave-one-arm-out, on the arm it leaves farthest short of its own model (the FR3; ARMS=fr3,xarm7
+# adds the xArm7, the other arm more than 3 points short): the family trained with the arm's
+# first two training sessions added, scored on its held-out session before and after
+# commissioning, and on its other six training sessions (validation); then the class gaps
+# (class_gaps.py). Reads the corpora run_false_alarms.sh records; about 30 minutes per arm and
+# seed on 2 cores.
+#   bash studies/arms/run_unseen_sessions.sh
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+PY=${PY:-.venv/bin/python}
+ARMS=${ARMS:-fr3}
+N=${UNSEEN_SESSIONS:-2}
+OUT=outputs/campaign_family_plus$N
+FAMILY=ur5e,ur3e,ur10e,ur16e,ur20,ur30,fr3,iiwa14,gen3,xarm7
+for arm in ${ARMS//,/ }; do
+  UNSEEN_SESSIONS=$N PY=$PY bash studies/arms/loao_one_arm.sh $arm $FAMILY $OUT
+  V="$PY studies/arms/campaign.py --arms $arm --family $FAMILY --stages loao --out $OUT"
+  V="$V --seeds ${SEEDS:-42} --unseen-sessions $N"
+  $V --variants gbdt --steps validate
+  $V --variants mlp,anomaly_residual --normalisation shift --steps validate
+  # validation picks the networks as trained over commissioned here: export them and count
+  # their alarms over the arm's healthy hour too
+  for run in "$OUT"/full/loao/$arm/*/full/*/{mlp,anomaly_residual}/w32/seed*; do
+    [[ -f $run/model.onnx ]] ||
+      $PY -m robohealth_mj.export ckpt=$run/best.ckpt data=outputs/corpus/arms/$arm/heldout_seed900
+  done
+  $V --variants mlp,anomaly_residual --normalisation shift --steps alarms
+done
+S="$PY studies/arms/summarise.py --own outputs/campaign_seven --normalisation shift"
+S="$S --baseline-normalisation none --seeds ${SEEDS:-42} --out $OUT"
+$S --against outputs/campaign_family_fixed > studies/arms/results/family_plus${N}_shift.md
+$S --as-trained > studies/arms/results/family_plus${N}_as_trained.md
+G="$PY studies/arms/class_gaps.py --arms $ARMS --out $OUT"
+$G > studies/arms/results/class_gaps_plus$N.md
+$G --as-trained > studies/arms/results/class_gaps_plus${N}_as_trained.md
