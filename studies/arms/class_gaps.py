@@ -64,7 +64,8 @@ def main() -> None:
     parser.add_argument("--baseline-normalisation", default="none", choices=MATCHES)
     parser.add_argument("--as-trained", action="store_true", help="the models as trained")
     args = parser.parse_args()
-    print("| unseen arm | variant | seeds | class | own recall | unseen, commissioned | "
+    read = "as trained" if args.as_trained else "commissioned"
+    print(f"| unseen arm | variant | seeds | class | own recall | unseen, {read} | "
           "points of accuracy |\n|---|---|---|---|---|---|---|")  # fmt: skip
     for arm in args.arms.split(","):
         for variant in args.variants.split(","):
