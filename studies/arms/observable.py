@@ -20,17 +20,12 @@ import json
 from pathlib import Path
 
 import numpy as np
+from class_gaps import seed_runs  # this folder's: one arm's runs of a variant, by seed
 
 from robohealth_mj.data.observability import MOTION_ONLY_FAULTS
 from robohealth_mj.learn.evaluation import evaluate_checkpoint, write_evaluation
 
 REFERENCE = "ur5e"
-
-
-def runs(own: Path, arm: str, variant: str) -> list[Path]:
-    """One arm's own runs of ``variant`` (``.../<variant>/w32/seed<s>``), by seed."""
-    found = own.glob(f"{arm}/*/full/*/{variant}/w32/seed*/best.ckpt")
-    return sorted(p.parent for p in found if (p.parent / "eval_heldout.json").is_file())
 
 
 def visible_score(run: Path) -> dict:
@@ -53,7 +48,7 @@ def unseen_share(metrics: dict) -> float:
 def arm_figures(own: Path, arm: str, variant: str) -> np.ndarray | None:
     """Seed means of [acc., loc., observable acc., observable loc., unseen share, seeds]."""
     rows = []
-    for run in runs(own, arm, variant):
+    for _, run in sorted(seed_runs(own, arm, variant).items()):
         as_labelled = json.loads((run / "eval_heldout.json").read_text())["metrics"]
         visible = visible_score(run)
         rows.append(
