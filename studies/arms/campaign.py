@@ -25,12 +25,13 @@ with more training sessions per arm) and writes under ``outputs/campaign_arms``:
   healthy minutes (``healthy_commissioning_seed940``, ``941``, ...; the corpus records them with
   ``'corpus.healthy_commissioning.seeds=[940,941,942]'``) into ``commissioned<N>...``. The
   ``validate`` step scores each leave-one-arm-out model, before and after commissioning, on the
-  unseen arm's training sessions
-  (``eval_validation.json``): labelled running of that arm that no model here trained on, where a
-  commissioning recipe is chosen before its held-out session is read. With ``--unseen-sessions
+  unseen arm's validation sessions (``validation_seed500``, ``501``; ``eval_validation.json``):
+  labelled running of that arm, in training's distribution, on programmes no model here trained
+  on, where a recipe is chosen before the held-out session is read. (The arm's own training
+  sessions will not do: a seed gives every arm of one joint count the same program and fault
+  schedule, which the other arms' sessions of that seed trained on.) With ``--unseen-sessions
   N`` the first N of the unseen arm's training sessions join the family's (what a few of the
-  arm's own simulated sessions buy over leave-one-arm-out; give it its own ``--out``), and
-  ``validate`` scores on the arm's other training sessions.
+  arm's own simulated sessions buy over leave-one-arm-out; give it its own ``--out``).
 
 Every step skips what is done, so an interrupted campaign resumes. Training runs through the
 package's own entry points (Hydra multirun, two jobs of one thread).
@@ -154,14 +155,10 @@ def commission_and_score(
         score(done, arm_dir)
 
 
-def score(
-    run_dir: Path, arm_dir: Path, split: str = "heldout", sessions: list[str] | None = None
-) -> None:
+def score(run_dir: Path, arm_dir: Path, split: str = "heldout") -> None:
     """``run_dir``'s checkpoint on the held-out session of ``arm_dir`` as ``eval_heldout.json``,
-    or (``split="validation"``) on its training sessions (``sessions``, default all of them) as
-    ``eval_validation.json``."""
-    data = arm_dir / "heldout_seed900" if split == "heldout" else f"{arm_dir}/train_*"
-    data = f"[{','.join(sessions)}]" if split != "heldout" and sessions else data
+    or (``split="validation"``) on its validation sessions as ``eval_validation.json``."""
+    data = arm_dir / "heldout_seed900" if split == "heldout" else f"{arm_dir}/validation_seed*"
     run_step("robohealth_mj.evaluate", f"ckpt={run_dir / 'best.ckpt'}",
              f"data={data}", f"out={run_dir / f'eval_{split}'}")  # fmt: skip
 
@@ -247,8 +244,7 @@ def main() -> None:
         type=int,
         default=0,
         help="the first N of the unseen arm's training sessions join the family's (default 0: "
-        "leave-one-arm-out proper); validate scores on its other training sessions; give the "
-        "campaign its own --out",
+        "leave-one-arm-out proper); give the campaign its own --out",
     )
     args = parser.parse_args()
     arms = args.arms.split(",")
@@ -262,6 +258,12 @@ def main() -> None:
         )
     stages, steps = args.stages.split(","), args.steps.split(",")
     variants = args.variants.split(",")
+    unvalidated = [a for a in arms if not any((root / a).glob("validation_seed*/graphs.jsonl"))]
+    if "validate" in steps and unvalidated:
+        raise SystemExit(
+            f"no validation sessions for {', '.join(unvalidated)}: record them with the arm's "
+            "corpus command again (conf/corpus/arms.yaml, role validation)"
+        )
     for arm in arms:
         heldout = root / arm / "heldout_seed900"
         own = args.out / args.sensing / "own" / arm
@@ -272,8 +274,8 @@ def main() -> None:
                 rescore(run_dir, root / arm)
         if "loao" in stages:
             sessions = sorted(str(p) for p in (root / arm).glob("train_*"))
-            seen, unseen = sessions[: args.unseen_sessions], sessions[args.unseen_sessions :]
-            others = [f"{root}/{a}/train_*" for a in family if a != arm] + seen
+            others = [f"{root}/{a}/train_*" for a in family if a != arm]
+            others += sessions[: args.unseen_sessions]
             sweep = args.out / args.sensing / "loao" / arm
             if "train" in steps:
                 train(sweep, others, heldout, args, "transfer=true")
@@ -291,7 +293,7 @@ def main() -> None:
                         if (scored / "best.ckpt").is_file() and not (
                             scored / "eval_validation.json"
                         ).is_file():
-                            score(scored, root / arm, "validation", unseen)
+                            score(scored, root / arm, "validation")
                 if "alarms" in steps:  # networks: a streaming runtime; the model as trained
                     for scored in (run_dir, done):  # too where it was exported
                         if (scored / "model.onnx").is_file():

@@ -38,7 +38,7 @@ all_jobs() {
 for arm in ur5e ur10e ur3e ur16e; do
   $PY -m robohealth_mj.corpus corpus=arms out_dir="$CORPUS/$arm" \
     "record_overrides=[\"arm=$arm\"]" progress=false jobs=4 '~corpus.healthy_commissioning' \
-    '~corpus.healthy_hour' '~corpus.probe_payload_high' ${MORE[@]+"${MORE[@]}"} &
+    '~corpus.healthy_hour' '~corpus.probe_payload_high' '~corpus.validation' ${MORE[@]+"${MORE[@]}"} &
 done
 wait
 for arm in ur5e ur10e ur3e ur16e; do

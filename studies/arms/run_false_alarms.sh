@@ -47,7 +47,7 @@ $PY -m robohealth_mj.corpus corpus=arms out_dir=outputs/corpus/arms/ur5e progres
 for arm in ur3e ur10e ur16e ur20 ur30; do
   $PY -m robohealth_mj.corpus corpus=arms out_dir=outputs/corpus/arms/$arm progress=false \
     corpus.train.sessions=2 "record_overrides=[\"arm=$arm\"]" '~corpus.probe_payload_high' \
-    '~corpus.healthy_hour' '~corpus.healthy_commissioning'
+    '~corpus.healthy_hour' '~corpus.healthy_commissioning' '~corpus.validation'
 done
 for arm in ${FAMILY_ARMS:-iiwa14 xarm7 fr3 gen3}; do
   PY=$PY bash studies/arms/loao_one_arm.sh $arm ur5e,ur3e,ur10e,ur16e,ur20,ur30,$SEVEN \

@@ -49,7 +49,7 @@ $PY studies/arms/healthy_offsets.py --campaign outputs/campaign_seven > studies/
 for arm in ur3e ur10e ur16e ur20 ur30; do
   $PY -m robohealth_mj.corpus corpus=arms out_dir=outputs/corpus/arms/$arm progress=false \
     corpus.train.sessions=2 "record_overrides=[\"arm=$arm\"]" '~corpus.probe_payload_high' \
-    '~corpus.healthy_hour' '~corpus.healthy_commissioning'
+    '~corpus.healthy_hour' '~corpus.healthy_commissioning' '~corpus.validation'
 done
 F="$L --family ur5e,ur3e,ur10e,ur16e,ur20,ur30,$SEVEN"
 F="${F/campaign_seven/campaign_family}"

@@ -147,6 +147,23 @@ def test_standard_corpus_plan_has_the_thesis_roles():
     assert "curriculum.payload_scales=[2.2]" in probe.overrides
 
 
+def test_the_arms_corpus_validates_on_programmes_no_arm_trains_on():
+    """A seed fixes the program and fault schedule of every arm of one joint count, so the
+    sessions that choose a recipe for an arm left out of training take seeds no session of any
+    arm trains on, and training's fault schedule."""
+    specs = plan(compose_config("corpus", ["corpus=arms"]).corpus, [])
+    seeds = {role: {s.overrides[0] for s in specs if s.role == role}
+             for role in ("train", "validation", "heldout")}  # fmt: skip
+    assert len(seeds["validation"]) >= 2
+    assert not seeds["validation"] & (seeds["train"] | seeds["heldout"])
+
+    def schedule(spec) -> list[str]:
+        return [o for o in spec.overrides if o.startswith("faults.")]
+
+    train = next(s for s in specs if s.role == "train")
+    assert all(schedule(s) == schedule(train) for s in specs if s.role == "validation")
+
+
 def _healthy_segment_starts(overrides: tuple[str, ...]) -> float:
     """Share of one fault pass's curriculum segment starts that fall in a healthy interval."""
     from hydra.utils import instantiate
