@@ -5,7 +5,7 @@
 # skips what is recorded), moves the old scores on the arm's training sessions aside as
 # eval_validation_shared_programme.json, scores every family leave-one-arm-out model
 # (run_family_seeds.sh) and two-own-sessions model (run_unseen_sessions.sh) there, and writes the
-# tables. About 40 minutes on 2 cores, beside another campaign.
+# tables. About 50 minutes on 2 cores, beside another campaign.
 #   bash studies/arms/run_validation.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
