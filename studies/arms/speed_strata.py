@@ -15,25 +15,15 @@ speeds), the shared programmes are (``validation_sessions.py``). Reads the runs 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
-import re
 from pathlib import Path
 
 import numpy as np
 from class_gaps import seed_runs  # this folder's: one arm's runs of a variant, by seed
 
+from robohealth_mj.data.read import read_samples
 from robohealth_mj.learn.evaluation import score_checkpoint
-from robohealth_mj.learn.metrics import metrics_of
-from robohealth_mj.learn.predict import Predictions
-
-SPEED = re.compile(rb'"speed_scale":([0-9.]+)')
-
-
-def sample_speeds(graphs: Path) -> np.ndarray:
-    """``[T]``: the speed scale of each sample's curriculum segment, in file order."""
-    with graphs.open("rb") as lines:
-        return np.array([float(SPEED.search(line).group(1)) for line in lines])
+from robohealth_mj.learn.metrics import compute_metrics
 
 
 def strata(run: Path) -> dict[float, tuple[float, float, float]]:
@@ -43,20 +33,17 @@ def strata(run: Path) -> dict[float, tuple[float, float, float]]:
     files = scored.files
     if len(files) != 1:
         raise SystemExit(f"{run}: expected one held-out recording, got {len(files)}")
-    speeds = sample_speeds(Path(files[0]))
+    speeds = np.array([s.segment["speed_scale"] for s in read_samples(files[0])])
     # the recording's rows are its samples in file order; a window takes its last sample's label
     ends = scored.windows.start + scored.windows.window - 1
     speed = speeds[scored.rec.sample_index[ends]]
     p = scored.predictions
+    called = (p.class_logits.argmax(1), p.joint_logits.argmax(1))
+    truth = (p.true_class, p.true_joint, p.active, p.true_severity)
     out = {}
     for s in np.unique(speed):
         mask = speed == s
-        part = Predictions(**{
-            f.name: (getattr(p, f.name)[mask] if isinstance(getattr(p, f.name), np.ndarray)
-                     else getattr(p, f.name))
-            for f in dataclasses.fields(p)
-        })  # fmt: skip
-        m = metrics_of(part)
+        m = compute_metrics(*(a[mask] for a in (*called, *truth)))
         out[float(s)] = (float(mask.mean()), m["accuracy"], m["localisation_accuracy"])
     return out
 

@@ -21,12 +21,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 from pathlib import Path
 
 import numpy as np
 from normalisation import RECIPES  # this folder's: recipe name -> directory under a run
 
+from robohealth_mj.data.windows import session_of
 from robohealth_mj.learn.evaluation import evaluate_checkpoint
 from robohealth_mj.reporting.markdown import heading
 
@@ -72,10 +72,10 @@ def collect(root: Path, seeds: list[int], recipes: dict[str, str]) -> dict[tuple
     return rows
 
 
-def trained_seeds(run: Path) -> set[str]:
-    """The corpus seeds whose sessions the run trained on (its run-aware split's train part)."""
+def trained_sessions(run: Path) -> set[str]:
+    """The sessions (program and fault schedule) the run trained on, on any arm."""
     split = json.loads((run / "train_summary.json").read_text())["split_runs"]
-    return {re.search(r"-s(\d+)-", r).group(1) for r in split["train"]}
+    return {session_of(r) for r in split["train"]}
 
 
 def per_session(runs: list[Path]) -> None:
@@ -86,11 +86,12 @@ def per_session(runs: list[Path]) -> None:
     )
     for run in runs:
         held = json.loads((run / "eval_heldout.json").read_text())["data"][0]
-        arm_dir, trained = Path(held).parents[1], trained_seeds(run)
+        arm_dir, trained = Path(held).parents[1], trained_sessions(run)
         for session in sorted(arm_dir.glob("train_*")):
-            seed = session.name.rsplit("seed", 1)[1]
+            run_id = json.loads((session / "manifest.json").read_text())["recording_run_id"]
+            seen = session_of(run_id) in trained
             m = evaluate_checkpoint(run / "best.ckpt", str(session), "cpu")["metrics"]
-            lines.append(f"| {run} | {session.name} | {'yes' if seed in trained else 'no'} | "
+            lines.append(f"| {run} | {session.name} | {'yes' if seen else 'no'} | "
                          f"{m['accuracy']:.3f} | {m['localisation_accuracy']:.3f} |")  # fmt: skip
     print("\n".join(lines))
 
