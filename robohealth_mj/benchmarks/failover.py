@@ -10,8 +10,11 @@ then restarts it:
 - *recovered*: from the kill to the first diagnosis of each of its arms by another monitor (the
   first with a decision comes a window later: the taker starts the arm's window afresh);
 - *twice*: ticks of any arm diagnosed by two monitors from 3 s after the kill to the restart;
-- *lost*: ticks an arm missed outside its gap (the ticks some arm got, this one did not, from
-  its first diagnosis on, less those between the kill and its recovery);
+- *lost*: ticks an arm missed between its first and its latest diagnosis (every arm gets every
+  tick's stamp: the stamps some arm got and this one did not), less its gap after a kill (the
+  ticks after the last one the killed monitor diagnosed and before the first its taker did).
+  Counted in stamps, not arrival times, so a monitor that lags under load (its ticks in flight
+  when killed, or still on their way) does not look like one that drops ticks;
 - *restored*: from the restart until every arm is diagnosed by one monitor again and the
   restarted one holds what it held before.
 """
@@ -32,9 +35,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-
-TICK_S = 0.05
-IN_FLIGHT_S = 0.25  # a tick published this long before a kill may die with the monitor
 
 
 @dataclass
@@ -67,25 +67,28 @@ class Arrivals:
             count += sum(len(ws) > 1 for ws in by_stamp.values())
         return count
 
-    def lost(self, gaps: dict[str, list[tuple[float, float]]], until: float) -> int:
-        """Ticks missed by an arm that another arm got (all arms get every tick's stamp), from
-        the arm's first diagnosis to ``until`` less a second (in flight), outside its ``gaps``
-        (arrival-time intervals)."""
-        every: dict[int, float] = {}
-        for rows in self.rows.values():
-            for t, s, _, _ in rows:
-                every[s] = min(t, every.get(s, t))
+    def gap(self, arm: str, killed: float, victim: set[int]) -> tuple[int, int]:
+        """The stamps an arm lost to a kill, as an open interval: after the last tick the killed
+        monitor (writers ``victim``) diagnosed, before the first another writer diagnosed since."""
+        rows = self.rows[arm]
+        last = max((s for _, s, w, _ in rows if w in victim), default=-1)
+        taken = [s for t, s, w, _ in rows if t >= killed and w not in victim]
+        return last, min(taken, default=sys.maxsize)
+
+    def lost(self, gaps: dict[str, list[tuple[int, int]]]) -> int:
+        """Ticks an arm missed that another arm got, between its own first and latest diagnosis,
+        outside its ``gaps`` (open stamp intervals)."""
+        every = {s for rows in self.rows.values() for _, s, _, _ in rows}
         missed = 0
         for arm, rows in self.rows.items():
             got = {s for _, s, _, _ in rows}
-            first = min((s for _, s, _, _ in rows), default=None)
-            if first is None:
+            if not got:
                 continue
-            for stamp, seen in every.items():
-                if stamp < first or stamp in got or seen > until - 1.0:
-                    continue
-                if not any(a - TICK_S <= seen <= b + TICK_S for a, b in gaps.get(arm, ())):
-                    missed += 1
+            first, latest = min(got), max(got)
+            missed += sum(
+                first < s < latest and not any(a < s < b for a, b in gaps.get(arm, ()))
+                for s in every - got
+            )
         return missed
 
 
@@ -98,7 +101,7 @@ class Listener:
         from robohealth_mj.ros2.idl import TYPES
         from robohealth_mj.ros2.node import arm_topics
 
-        config = BusConfig(domain_id=domain, interface="127.0.0.1", depth=200,
+        config = BusConfig(domain_id=domain, interface="127.0.0.1", depth=1000,
                            reliable_subscriptions=True)  # fmt: skip
         self.bus = Bus(config)
         kind = TYPES["diagnostic_msgs/msg/DiagnosticArray"]
@@ -160,8 +163,10 @@ class Monitors:
         self.procs[name] = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT)
         log.close()
 
-    def wait_listening(self, name: str, timeout_s: float = 60.0) -> None:
-        """Until the monitor says it is on the bus (its model loaded, its share taken)."""
+    def wait_listening(self, name: str, idle: Any = time.sleep, timeout_s: float = 60.0) -> None:
+        """Until the monitor says it is on the bus (its model loaded, its share taken), calling
+        ``idle(seconds)`` meanwhile (the listener's ``listen``: a reader left unread for the
+        seconds a loaded machine takes to start a monitor overflows and looks like loss)."""
         log = self.logs / f"{name}.{self.starts[name]}.log"
         end = time.monotonic() + timeout_s
         while time.monotonic() < end:
@@ -169,7 +174,7 @@ class Monitors:
                 return
             if self.procs[name].poll() is not None:
                 raise RuntimeError(f"{name} exited: {log.read_text()[-2000:]}")
-            time.sleep(0.1)
+            idle(0.1)
         raise TimeoutError(f"{name} did not start in {timeout_s:.0f} s ({log})")
 
     def kill(self, name: str) -> None:
@@ -213,11 +218,11 @@ def failover(
             for name in group.names:
                 group.start(name)
             for name in group.names:
-                group.wait_listening(name)
+                group.wait_listening(name, listener.listen)
             before = listener.wait_settled(30.0 + handover_s)
             if before is None:
                 raise RuntimeError(f"the group did not settle: {listener.current_writers()}")
-            gaps: dict[str, list[tuple[float, float]]] = defaultdict(list)
+            gaps: dict[str, list[tuple[int, int]]] = defaultdict(list)
             # the victims in turn, the one watching the most arms first
             victims = sorted(group.names, key=lambda m: -len(share(names, group.names, m)))
             for cycle in range(cycles):
@@ -231,12 +236,12 @@ def failover(
                              for a in theirs]  # fmt: skip
                 decided = [listener.arrivals.first_after(a, killed, handles, True) - killed
                            for a in theirs]  # fmt: skip
-                for a, r in zip(theirs, recovered, strict=True):  # with the ticks in flight
-                    gaps[a].append((killed - IN_FLIGHT_S, killed + r))
+                for a in theirs:
+                    gaps[a].append(listener.arrivals.gap(a, killed, handles))
                 restarted = time.monotonic()
                 twice = listener.arrivals.twice(killed + 3.0, restarted)
                 group.start(victim)
-                group.wait_listening(victim)
+                group.wait_listening(victim, listener.listen)
                 after = listener.wait_settled(handover_s + 15.0)
                 restored = time.monotonic() - restarted
                 moved = {a for a in names if after is not None and after[a] != before[a]}
@@ -245,7 +250,7 @@ def failover(
                     "recovered_max_s": max(recovered), "recovered_median_s":
                     float(np.median(recovered)), "decided_max_s": max(decided),
                     "twice_after_3s": twice,
-                    "lost": listener.arrivals.lost(gaps, time.monotonic()),
+                    "lost": listener.arrivals.lost(gaps),
                     "restored_s": restored if after is not None else float("inf"),
                     "shares_restored": after is not None and moved == set(theirs),
                 })  # fmt: skip

@@ -7,11 +7,15 @@ same member list, the member with the highest hash of (member, arm) (rendezvous 
 highest-random-weight hashing), so a member leaving moves only its own arms, each to the member
 that ranks second for it, and a member joining takes only the arms it now ranks first for.
 
-A member that joins is *joining* for ``handover_s`` in the others' eyes: it diagnoses its share
-at once, and the member that had each of those arms keeps it until the joiner has been heard for
-``handover_s`` (its window has filled by then), so a join loses no sample and two monitors
-diagnose one arm only during the handover. A member that stops cleanly says so (``leaving``) and
-its arms move at once; one that is killed moves them once it has been silent ``timeout_s``.
+A member that joins says ``joining`` while it listens and makes its readers, then ``active``:
+from then on it diagnoses its share, and the member that had each of those arms keeps it until
+the joiner has been active for ``handover_s`` (its window has filled by then). The handover is
+counted from the first ``active`` beat, not the first beat: a joiner's readers must be on the
+bus before the owner stops reading, or the ticks between are lost (counted from the first beat,
+a handover shorter than the joiner's listening left the two racing). So a join loses no sample
+and two monitors diagnose one arm only during the handover. A member that stops cleanly says so
+(``leaving``) and its arms move at once; one that is killed moves them once it has been silent
+``timeout_s``.
 What the taker starts from: a fresh window (decisions resume once it has filled) and fresh alarm
 state (an alarm up on the dead monitor is raised again after its persistence), because neither
 travels between processes.
@@ -39,7 +43,7 @@ from typing import Any
 from robohealth_mj.common.errors import InputError
 
 GROUP_TOPIC = "/robohealth/monitor_group"
-ACTIVE, LEAVING = "active", "leaving"
+JOINING, ACTIVE, LEAVING = "joining", "active", "leaving"
 SKEW_WINDOW_S = 30.0  # a member's clock offset is the least beat age seen within this long
 
 
@@ -103,14 +107,15 @@ class MonitorGroup:
         self._writer = bus.writer(GROUP_TOPIC, self._status)
         self._reader = bus.reader(GROUP_TOPIC, self._status)
         self._heard: dict[str, float] = {}  # member -> when last heard (monotonic)
-        self._first: dict[str, float] = {}  # member -> when first heard this time round
+        self._first: dict[str, float] = {}  # member -> when first heard active this time round
         self._offset: dict[str, tuple[float, float]] = {}  # member -> (least beat age, since)
         self._next_beat = 0.0
         self._watching: list[str] = []
         self._members: tuple[list[str], list[str]] | None = None  # (live, settled) last shared
+        self._state = JOINING  # until the first update() after discover(): the readers exist
 
-    def _beat(self, now: float, state: str = ACTIVE) -> None:
-        self._writer.write(self._status(level=0, name=self.me, message=state,
+    def _beat(self, now: float, state: str | None = None) -> None:
+        self._writer.write(self._status(level=0, name=self.me, message=state or self._state,
                                          hardware_id=socket.gethostname(), values=[]))  # fmt: skip
         self._next_beat = now + self.config.heartbeat_s
 
@@ -122,7 +127,10 @@ class MonitorGroup:
                 self._heard.pop(msg.name, None)
                 self._first.pop(msg.name, None)
                 continue
-            self._first.setdefault(msg.name, now)
+            if msg.message == JOINING:  # live, its handover not begun (again, if it restarted
+                self._first.pop(msg.name, None)  # faster than the timeout)
+            else:
+                self._first.setdefault(msg.name, now)
             sent = now - self._lateness(msg.name, msg, now)
             self._heard[msg.name] = max(self._heard.get(msg.name, sent), sent)
 
@@ -148,7 +156,9 @@ class MonitorGroup:
     def discover(self) -> list[str]:
         """Heartbeat and listen for one ``timeout_s`` before taking any arm (a monitor that
         took every arm until it heard the others would make every arm change hands at start);
-        those already there count as settled. Returns this monitor's first share."""
+        those already there count as settled. Returns this monitor's first share; it says
+        ``active`` (and the handover of that share begins) at the first :meth:`update`, once
+        the caller has made the share's readers."""
         start = time.monotonic()
         while (now := time.monotonic()) - start < self.config.timeout_s:
             if now >= self._next_beat:
@@ -157,16 +167,20 @@ class MonitorGroup:
             time.sleep(min(0.02, self.config.heartbeat_s / 4))
         for member in self._first:
             self._first[member] = -float("inf")
-        return self.update(time.monotonic())
+        return self._shares(time.monotonic())
 
     def update(self, now: float | None = None) -> list[str]:
         """Heartbeat when due, hear the others, and return the arms to watch now: those this
         monitor owns among the live members, and those it owned before a joiner came that the
         joiner has not held for ``handover_s`` yet."""
         now = time.monotonic() if now is None else now
-        if now >= self._next_beat:
+        if now >= self._next_beat or self._state == JOINING:
+            self._state = ACTIVE
             self._beat(now)
         self._listen(now)
+        return self._shares(now)
+
+    def _shares(self, now: float) -> list[str]:
         live = self.members(now)
         for gone in set(self._first) - set(live):  # silent past the timeout: back later, it joins
             del self._first[gone]

@@ -102,13 +102,26 @@ def test_members_find_each_other_share_the_arms_and_take_over_from_a_silent_one(
     assert a.update() == ARMS and 0.2 < time.monotonic() - silent_since < 2.0
 
     alive_a = _Alive(a)  # a goes on heartbeating while c discovers
-    joined = time.monotonic()
     c_share = c.discover()
     alive_a.kill()
     assert c_share == share(ARMS, ["a", "c"], "c")  # c diagnoses its share at once ...
-    assert a.update() == ARMS  # ... while a keeps it through the handover
+    assert a.update() == ARMS  # ... while a keeps it through the handover, counted from c's
+    active = time.monotonic()  # first update (its readers made), not from its first beat
     _until(lambda: (c.update(), a.update())[1] == share(ARMS, ["a", "c"], "a"))
-    assert a.update() == share(ARMS, ["a", "c"], "a") and time.monotonic() - joined >= 1.0
+    assert a.update() == share(ARMS, ["a", "c"], "a") and time.monotonic() - active >= 1.0
+
+    # c restarted faster than the timeout: its arms come back to a while it says it is joining
+    alive_c = _Alive(c)
+    again = MonitorGroup(buses[2], GroupConfig("c", **{**config, "timeout_s": 3.0}), ARMS)
+    joining = threading.Thread(target=again.discover, daemon=True)
+    joining.start()
+    alive_c.kill()
+    _until(lambda: a.update() == ARMS, timeout_s=2.5)
+    assert a.update() == ARMS and joining.is_alive()  # not a's timeout: "c" beats throughout
+    joining.join()
+    c = again  # active now: a lets its share go after the handover again
+    _until(lambda: (c.update(), a.update())[1] == share(ARMS, ["a", "c"], "a"))
+    assert a.update() == share(ARMS, ["a", "c"], "a")
 
     c.leave()
     _until(lambda: a.update() == ARMS, timeout_s=0.3)  # at once, not after the timeout
@@ -154,6 +167,25 @@ def test_arms_moved_out_and_back_in_lose_their_readers_then_start_a_fresh_window
     assert again[0].reason and "warming" in again[0].reason  # its window starts afresh
     for bus in (robot, monitor):
         bus.close()
+
+
+def test_the_failover_bench_counts_a_hole_as_lost_but_not_a_lagging_monitor_s_ticks():
+    """Lost ticks are counted in stamps: a killed monitor's ticks still in flight and ticks on
+    their way to the listener are no loss; a tick missing between two diagnoses is."""
+    from robohealth_mj.benchmarks.failover import Arrivals
+
+    arrivals = Arrivals()
+    for stamp in range(20):  # arm1: every tick, on time, from writer 1
+        arrivals.rows["arm1"].append((stamp * 0.05, stamp, 1, True))
+    # arm2's monitor (writer 2) lags 0.5 s and dies at 0.6 s having diagnosed ticks 0 and 1;
+    # writer 3 takes the arm from tick 14, and its newest ticks have not arrived yet
+    arrivals.rows["arm2"] += [(0.5 + stamp * 0.05, stamp, 2, True) for stamp in range(2)]
+    arrivals.rows["arm2"] += [(0.1 + stamp * 0.05, stamp, 3, False) for stamp in range(14, 18)]
+    gap = arrivals.gap("arm2", 0.6, victim={2})
+    assert gap == (1, 14) and arrivals.lost({"arm2": [gap]}) == 0
+    del arrivals.rows["arm2"][3]  # the taker misses tick 15
+    assert arrivals.lost({"arm2": [gap]}) == 1
+    assert arrivals.lost({}) == 12 + 1  # ticks 2..13 without the gap
 
 
 def test_three_monitor_processes_cover_for_one_killed_and_take_it_back_on_restart(deployed):
