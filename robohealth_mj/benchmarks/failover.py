@@ -30,6 +30,7 @@ import sys
 import tempfile
 import time
 from collections import defaultdict
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -163,7 +164,9 @@ class Monitors:
         self.procs[name] = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT)
         log.close()
 
-    def wait_listening(self, name: str, idle: Any = time.sleep, timeout_s: float = 60.0) -> None:
+    def wait_listening(
+        self, name: str, idle: Callable[[float], Any] = time.sleep, timeout_s: float = 60.0
+    ) -> None:
         """Until the monitor says it is on the bus (its model loaded, its share taken), calling
         ``idle(seconds)`` meanwhile (the listener's ``listen``: a reader left unread for the
         seconds a loaded machine takes to start a monitor overflows and looks like loss)."""
