@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Issue 65, item 4, the stock profile left out: each arm of ARMS (default the FR3) left out of
+# the whole family's training (UR e-Series and the seven-joint arms), read on what its
+# controller reports (sensing=stock), W = 32, at SEEDS (default 42). gbdt, mlp and stgnn_fixed,
+# the graph network this profile can have (no sensor nodes, so no coupling head and no
+# headline); commissioned as on the full profile (gbdt: none; the networks: shift), then every
+# recipe scored on the arm's validation sessions (programs no arm trains on) to pick one; the
+# networks as trained are exported and their alarms counted too.
+# Reads the corpora run_seven.sh and run_validation.sh record and the own stock models
+# run_stock_own.sh trains; about 10 minutes an arm at one seed on 2 cores, 25 at two.
+#   bash studies/arms/run_stock_loao.sh
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+PY=${PY:-.venv/bin/python}
+ARMS=${ARMS:-fr3}
+SEEDS=${SEEDS:-42}
+FAMILY=ur5e,ur3e,ur10e,ur16e,ur20,ur30,fr3,iiwa14,gen3,xarm7
+OUT=outputs/campaign_family_fixed
+for arm in ${ARMS//,/ }; do
+  SENSING=stock NETWORK=stgnn_fixed SEEDS=$SEEDS PY=$PY \
+    bash studies/arms/loao_one_arm.sh "$arm" $FAMILY $OUT
+  V="$PY studies/arms/campaign.py --arms $arm --family $FAMILY --stages loao --seeds $SEEDS"
+  V="$V --sensing stock --out $OUT --steps validate"
+  $V --variants gbdt,mlp,stgnn_fixed
+  $V --variants mlp,stgnn_fixed --normalisation shift
+  # validation may pick a network as trained: export those and count their alarms too
+  for run in $OUT/stock/loao/$arm/*/stock/*/{mlp,stgnn_fixed}/w32/seed*; do
+    [[ -f $run/model.onnx ]] ||
+      $PY -m robohealth_mj.export ckpt=$run/best.ckpt data=outputs/corpus/arms/$arm/heldout_seed900
+  done
+  $PY studies/arms/campaign.py --arms $arm --family $FAMILY --stages loao --seeds $SEEDS \
+    --sensing stock --out $OUT --variants mlp,stgnn_fixed --normalisation shift --steps alarms
+done
+S="$PY studies/arms/summarise.py --sensing stock --out $OUT --own outputs/campaign_seven"
+$S --normalisation shift --baseline-normalisation none > studies/arms/results/family_stock_shift.md
+$S --as-trained > studies/arms/results/family_stock_as_trained.md
+$PY studies/arms/validation_sessions.py --out $OUT --sensing stock \
+  --recipes uncommissioned,commissioned,commissioned_shift \
+  > studies/arms/results/validation_family_stock.md
