@@ -62,11 +62,12 @@ run: setup
 
 # Two pytest workers (pytest-xdist): the suite is one core's work end to end (training,
 # subprocesses), so two halve its wall time; the DDS tests share one worker (tests/ros2/conftest.py)
-# and the trained fixtures are built once for both (tests/conftest.py:cached).
+# and the trained fixtures are built once for both (tests/conftest.py:cached). The run ends with
+# its fifteen slowest tests, so a CI log says where the ten-minute budget goes.
 TEST_WORKERS ?= 2
 
 test: setup setup-sros2
-	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadgroup
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadgroup --durations=15
 
 test-fast: setup setup-sros2
 	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadgroup -m "not slow"

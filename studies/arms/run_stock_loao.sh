@@ -7,7 +7,9 @@
 # recipe scored on the arm's validation sessions (programs no arm trains on) to pick one; the
 # networks as trained are exported and their alarms counted too.
 # Reads the corpora run_seven.sh and run_validation.sh record and the own stock models
-# run_stock_own.sh trains; about 10 minutes an arm at one seed on 2 cores, 25 at two.
+# run_stock_own.sh trains; about 10 minutes an arm at one seed on 2 cores, 25 at two. The tables
+# go to studies/arms/results/TABLES_{shift,as_trained}.md and validation_TABLES.md (TABLES
+# defaults to family_stock).
 #   bash studies/arms/run_stock_loao.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -16,6 +18,7 @@ ARMS=${ARMS:-fr3}
 SEEDS=${SEEDS:-42}
 FAMILY=ur5e,ur3e,ur10e,ur16e,ur20,ur30,fr3,iiwa14,gen3,xarm7
 OUT=outputs/campaign_family_fixed
+TABLES=${TABLES:-family_stock}
 for arm in ${ARMS//,/ }; do
   SENSING=stock NETWORK=stgnn_fixed SEEDS=$SEEDS PY=$PY \
     bash studies/arms/loao_one_arm.sh "$arm" $FAMILY $OUT
@@ -32,8 +35,8 @@ for arm in ${ARMS//,/ }; do
     --sensing stock --out $OUT --variants mlp,stgnn_fixed --normalisation shift --steps alarms
 done
 S="$PY studies/arms/summarise.py --sensing stock --out $OUT --own outputs/campaign_seven"
-$S --normalisation shift --baseline-normalisation none > studies/arms/results/family_stock_shift.md
-$S --as-trained > studies/arms/results/family_stock_as_trained.md
+$S --normalisation shift --baseline-normalisation none > studies/arms/results/${TABLES}_shift.md
+$S --as-trained > studies/arms/results/${TABLES}_as_trained.md
 $PY studies/arms/validation_sessions.py --out $OUT --sensing stock \
   --recipes uncommissioned,commissioned,commissioned_shift \
-  > studies/arms/results/validation_family_stock.md
+  > studies/arms/results/validation_${TABLES}.md
