@@ -4,7 +4,7 @@ commissioning, and false alarms on the unseen arm's healthy hour.
     python studies/arms/campaign.py [--variants gbdt,stgnn_fixed] [--seeds 42,43,44]
         [--epochs 10] [--sensing full] [--arms ur3e,ur5e,ur10e,ur16e] [--family ARMS]
         [--stages own,loao]
-        [--steps train,rescore,commission,alarms,validate] [--healthy-rate 0.99]
+        [--steps train,rescore,commission,export,alarms,validate] [--healthy-rate 0.99]
         [--normalisation sensors|shift|moments] [--commissioning-minutes 10|20|30]
         [--unseen-sessions N]
 
@@ -17,21 +17,23 @@ with more training sessions per arm) and writes under ``outputs/campaign_arms``:
   ``<arm>``'s held-out session; ``commissioned/`` beside each: the model commissioned on ten
   minutes of ``<arm>``'s healthy running and scored again; networks are also replayed through the
   fleet runtime and the monitor's alarms over ``<arm>``'s healthy hour
-  (``alarms_healthy_hour_seed*.json``). With ``--healthy-rate R`` the commissioning asks for at
-  least R of the arm's healthy windows called healthy (``commission healthy_rate=R``, a quieter
-  operating point) and writes ``commissioned_hr<R>/`` instead. With ``--normalisation M`` the
-  commissioning also refits the z-scoring to the arm's healthy running (``commission
-  normalisation=M``) into ``commissioned_<M>/``. With ``--commissioning-minutes N`` it reads N
-  healthy minutes (``healthy_commissioning_seed940``, ``941``, ...; the corpus records them with
+  (``alarms_healthy_hour_seed*.json``); the ``export`` step exports the networks as trained too
+  (validation may pick one over its commissioned form), so that ``alarms`` counts theirs. With
+  ``--healthy-rate R`` the commissioning asks for at least R of the arm's healthy windows called
+  healthy (``commission healthy_rate=R``, a quieter operating point) and writes
+  ``commissioned_hr<R>/`` instead. With ``--normalisation M`` the commissioning also refits the
+  z-scoring to the arm's healthy running (``commission normalisation=M``) into
+  ``commissioned_<M>/``. With ``--commissioning-minutes N`` it reads N healthy minutes
+  (``healthy_commissioning_seed940``, ``941``, ...; the corpus records them with
   ``'corpus.healthy_commissioning.seeds=[940,941,942]'``) into ``commissioned<N>...``. The
   ``validate`` step scores each leave-one-arm-out model, before and after commissioning, on the
   unseen arm's validation sessions (``validation_seed500``, ``501``; ``eval_validation.json``):
   labelled running of that arm, in training's distribution, on programmes no model here trained
   on, where a recipe is chosen before the held-out session is read. (The arm's own training
   sessions will not do: a seed gives every arm of one joint count the same program and fault
-  schedule, which the other arms' sessions of that seed trained on.) With ``--unseen-sessions
-  N`` the first N of the unseen arm's training sessions join the family's (what a few of the
-  arm's own simulated sessions buy over leave-one-arm-out; give it its own ``--out``).
+  schedule, which the other arms' sessions of that seed trained on.) With ``--unseen-sessions N``
+  the first N of the unseen arm's training sessions join the family's (what a few of the arm's own
+  simulated sessions buy over leave-one-arm-out; give it its own ``--out``).
 
 Every step skips what is done, so an interrupted campaign resumes. Training runs through the
 package's own entry points (Hydra multirun, two jobs of one thread).
@@ -163,6 +165,15 @@ def score(run_dir: Path, arm_dir: Path, split: str = "heldout") -> None:
              f"data={data}", f"out={run_dir / f'eval_{split}'}")  # fmt: skip
 
 
+def export_as_trained(run_dir: Path, arm_dir: Path) -> None:
+    """``run_dir``'s network as trained to ONNX (``model.onnx`` beside ``best.ckpt``; the
+    commissioning exports its own form), its parity with the checkpoint checked on ``arm``'s
+    held-out session: the arm it will read, not the training arms'."""
+    if not (run_dir / "model.onnx").is_file():
+        run_step("robohealth_mj.export", f"ckpt={run_dir / 'best.ckpt'}",
+                 f"data={arm_dir / 'heldout_seed900'}")  # fmt: skip
+
+
 def healthy_alarms(done: Path, arm_dir: Path) -> None:
     """The commissioned network's alarms over ``arm``'s healthy hour under the monitor's default
     alarm and evidence policies (``conf/monitor.yaml``): the fleet runtime's decisions over the
@@ -199,8 +210,9 @@ def main() -> None:
     parser.add_argument(
         "--steps",
         default="train,rescore,commission,alarms",
-        help="any of train, rescore, commission, alarms, validate: train alone on a machine "
-        "that lacks the healthy sessions (a lent GPU), then the rest where they are",
+        help="any of train, rescore, commission, export (networks as trained: give --variants "
+        "networks only), alarms, validate: train alone on a machine that lacks the healthy "
+        "sessions (a lent GPU), then the rest where they are",
     )
     parser.add_argument(
         "--override",
@@ -294,6 +306,8 @@ def main() -> None:
                             scored / "eval_validation.json"
                         ).is_file():
                             score(scored, root / arm, "validation")
+                if "export" in steps:
+                    export_as_trained(run_dir, root / arm)
                 if "alarms" in steps:  # networks: a streaming runtime; the model as trained
                     for scored in (run_dir, done):  # too where it was exported
                         if (scored / "model.onnx").is_file():

@@ -23,16 +23,11 @@ for arm in ${ARMS//,/ }; do
   SENSING=stock NETWORK=stgnn_fixed SEEDS=$SEEDS PY=$PY \
     bash studies/arms/loao_one_arm.sh "$arm" $FAMILY $OUT
   V="$PY studies/arms/campaign.py --arms $arm --family $FAMILY --stages loao --seeds $SEEDS"
-  V="$V --sensing stock --out $OUT --steps validate"
-  $V --variants gbdt,mlp,stgnn_fixed
-  $V --variants mlp,stgnn_fixed --normalisation shift
+  V="$V --sensing stock --out $OUT"
+  $V --variants gbdt,mlp,stgnn_fixed --steps validate
+  $V --variants mlp,stgnn_fixed --normalisation shift --steps validate
   # validation may pick a network as trained: export those and count their alarms too
-  for run in $OUT/stock/loao/$arm/*/stock/*/{mlp,stgnn_fixed}/w32/seed*; do
-    [[ -f $run/model.onnx ]] ||
-      $PY -m robohealth_mj.export ckpt=$run/best.ckpt data=outputs/corpus/arms/$arm/heldout_seed900
-  done
-  $PY studies/arms/campaign.py --arms $arm --family $FAMILY --stages loao --seeds $SEEDS \
-    --sensing stock --out $OUT --variants mlp,stgnn_fixed --normalisation shift --steps alarms
+  $V --variants mlp,stgnn_fixed --normalisation shift --steps export,alarms
 done
 S="$PY studies/arms/summarise.py --sensing stock --out $OUT --own outputs/campaign_seven"
 $S --normalisation shift --baseline-normalisation none > studies/arms/results/${TABLES}_shift.md

@@ -23,11 +23,7 @@ for arm in ${ARMS//,/ }; do
   $V --variants mlp,anomaly_residual --normalisation shift --steps validate
   # validation picks the networks as trained over commissioned here: export them and count
   # their alarms over the arm's healthy hour too
-  for run in "$OUT"/full/loao/$arm/*/full/*/{mlp,anomaly_residual}/w32/seed*; do
-    [[ -f $run/model.onnx ]] ||
-      $PY -m robohealth_mj.export ckpt=$run/best.ckpt data=outputs/corpus/arms/$arm/heldout_seed900
-  done
-  $V --variants mlp,anomaly_residual --normalisation shift --steps alarms
+  $V --variants mlp,anomaly_residual --normalisation shift --steps export,alarms
 done
 S="$PY studies/arms/summarise.py --own outputs/campaign_seven --normalisation shift"
 S="$S --baseline-normalisation none --out $OUT"  # every seed run so far
