@@ -23,6 +23,8 @@ from robohealth_mj.learn.evaluation import evaluate_checkpoint
 from robohealth_mj.learn.run import train_and_evaluate
 from robohealth_mj.recording.recorder import record_session
 
+# a booster of a few small trees: these tests check which arms a model reads, not how well
+SMALL_BOOSTER = ["model.rounds=20", "model.num_leaves=7"]
 VEL, EFFORT, RESIDUAL, POS = (schema.feature_index(n)
                               for n in ("vel", "effort", "effort_residual", "pos"))  # fmt: skip
 
@@ -101,13 +103,13 @@ def test_a_model_reads_an_unseen_arm_only_when_trained_for_transfer(tmp_path, fa
         train_and_evaluate(cfg, tmp_path / name)
         return tmp_path / name / "best.ckpt"
 
-    plain = trained("plain", "variant=gbdt")
+    plain = trained("plain", "variant=gbdt", *SMALL_BOOSTER)
     with pytest.raises(InputError, match=r"a recording of a ur3e; the model was trained on "
                                          r"ur10e, ur5e .*transfer=true"):  # fmt: skip
         evaluate_checkpoint(plain, str(unseen))
     evaluate_checkpoint(plain, str(train[2]))  # its own arms read
 
-    transfer = trained("transfer", "variant=gbdt", "transfer=true")
+    transfer = trained("transfer", "variant=gbdt", "transfer=true", *SMALL_BOOSTER)
     metrics = evaluate_checkpoint(transfer, str(unseen))["metrics"]
     assert 0.0 <= metrics["accuracy"] <= 1.0
 
@@ -147,6 +149,7 @@ def test_arms_of_two_joint_counts_train_one_model_that_reads_a_third(tmp_path, f
     cfg = compose_config("train", [
         f"data.train=[{tmp_path}/train/*]", "data.evaluate.heldout=null", "variant=gbdt",
         "data.evaluate.probe=null", "trainer.progress=false", "window=8", "transfer=true",
+        *SMALL_BOOSTER,
     ])  # fmt: skip
     train_and_evaluate(cfg, tmp_path / "model")
     model = tmp_path / "model" / "best.ckpt"
