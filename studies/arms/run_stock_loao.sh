@@ -9,7 +9,7 @@
 # Reads the corpora run_seven.sh and run_validation.sh record and the own stock models
 # run_stock_own.sh trains; about 10 minutes an arm at one seed on 2 cores, 25 at two. The tables
 # go to studies/arms/results/TABLES_{shift,as_trained}.md and validation_TABLES.md (TABLES
-# defaults to family_stock).
+# defaults to family_stock), and the CSVs to results_campaign_family_fixed_[TAG_]*_stock.csv.
 #   bash studies/arms/run_stock_loao.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -30,6 +30,7 @@ for arm in ${ARMS//,/ }; do
   $V --variants mlp,stgnn_fixed --normalisation shift --steps export,alarms
 done
 S="$PY studies/arms/summarise.py --sensing stock --out $OUT --own outputs/campaign_seven"
+S="$S${TAG:+ --tag $TAG}"
 $S --normalisation shift --baseline-normalisation none > studies/arms/results/${TABLES}_shift.md
 $S --as-trained > studies/arms/results/${TABLES}_as_trained.md
 $PY studies/arms/validation_sessions.py --out $OUT --sensing stock \

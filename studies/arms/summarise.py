@@ -11,9 +11,10 @@ hour (the monitor's replay with its default alarm policy). Mean ± std over the 
 Then each network against ``gbdt`` after commissioning: ahead when the difference of the means
 exceeds the larger seed std (``--baseline-normalisation M``: ``gbdt``'s models commissioned with M,
 each model by its own validation's recipe, e.g. ``shift`` for the networks and ``none`` for the
-trees). Also writes ``studies/arms/results/results_<sensing>.csv`` (for another
-``--out``, ``results_<its name>_<sensing>.csv``). ``--healthy-rate R`` reads the models
-commissioned at that healthy rate (``campaign.py --healthy-rate R``) in place of validation's.
+trees). Also writes ``studies/arms/results/results_<sensing>.csv`` (for another ``--out``,
+``results_<its name>_<sensing>.csv``; ``--tag T``: ``results_<its name>_<T>_...``).
+``--healthy-rate R`` reads the models commissioned at that healthy rate (``campaign.py
+--healthy-rate R``) in place of validation's.
 ``--normalisation M`` reads the models commissioned with that normalisation
 (``campaign.py --normalisation M``), ``--commissioning-minutes N`` those commissioned on N
 healthy minutes. ``--against DIR`` adds each model beside the same model of
@@ -247,6 +248,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sensing", default="full")
     parser.add_argument("--out", type=Path, default=OUT, help="campaign root")
+    parser.add_argument(
+        "--tag", help="a word in the CSV's name, so that a run of a few arms keeps the others' CSV"
+    )
     parser.add_argument("--seeds", help="only these seeds, e.g. 42 or 42,43 (default: all found)")
     parser.add_argument(
         "--healthy-rate", type=float, help="the models commissioned at this healthy rate"
@@ -295,6 +299,7 @@ def main() -> None:
         raise SystemExit(f"no evaluations under {args.out / args.sensing}: run the campaign first")
     RESULTS.mkdir(parents=True, exist_ok=True)
     recipe = "" if args.out.resolve() == OUT.resolve() else f"{args.out.name}_"
+    recipe += f"{args.tag}_" if args.tag else ""
     recipe += f"seeds{'_'.join(sorted(seeds))}_" if seeds else ""
     recipe += f"{minutes}min_" if minutes != 10 else ""
     recipe += f"hr{rate:g}_" if rate is not None else ""
