@@ -16,5 +16,7 @@ C="$C --seeds ${SEEDS:-42,43,44} --out outputs/campaign_seven"
 ($C --variants gbdt --override model.severity=false && $C --variants mlp --epochs 10) &
 $C --variants stgnn_fixed --epochs 10
 wait
-$PY studies/arms/summarise.py --sensing stock --out outputs/campaign_seven \
-  > studies/arms/results/seven_joint_own_stock.md
+# OWN_TABLE= (empty): no table, for a runner that writes its own (run_stock_seeds.sh)
+OWN_TABLE=${OWN_TABLE-seven_joint_own_stock}
+[[ -z $OWN_TABLE ]] || $PY studies/arms/summarise.py --sensing stock --out outputs/campaign_seven \
+  > studies/arms/results/$OWN_TABLE.md

@@ -20,10 +20,6 @@ for arm in ${FAMILY//,/ }; do
   $PY -m robohealth_mj.corpus corpus=arms out_dir=outputs/corpus/arms/$arm progress=false \
     "record_overrides=[\"arm=$arm\"]" "${roles[@]}"
 done
-C="$PY studies/arms/campaign.py --arms $ARMS --stages own --steps train --sensing stock"
-C="$C --seeds 42,43,44 --out outputs/campaign_seven"
-($C --variants gbdt --override model.severity=false && $C --variants mlp --epochs 10) &
-$C --variants stgnn_fixed --epochs 10
-wait
+OWN_TABLE= ARMS=$ARMS SEEDS=42,43,44 PY=$PY bash studies/arms/run_stock_own.sh
 TABLES=${TABLES:-family_stock_seeds} TAG=${TAG:-seeds} ARMS=$ARMS SEEDS=42,43,44 PY=$PY \
   bash studies/arms/run_stock_loao.sh
