@@ -7,28 +7,42 @@
 # commissioning, and on its other six training sessions (validation); then the class gaps
 # (class_gaps.py). Reads the corpora run_false_alarms.sh records; seed 42 (SEEDS=43,44 for the
 # others), about 30 minutes per arm and seed on 2 cores; the tables read every seed run so far.
+# SENSING=stock NETWORK=stgnn_fixed runs the stock profile (the corpora run_stock_seeds.sh
+# records; its own models from outputs/campaign_seven; tables family_plusN_stock_*.md and
+# validation_plusN_stock.md, no class gaps).
 #   bash studies/arms/run_unseen_sessions.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 PY=${PY:-.venv/bin/python}
 ARMS=${ARMS:-fr3,xarm7}
 N=${UNSEEN_SESSIONS:-2}
+SENSING=${SENSING:-full}
+NET=${NETWORK:-anomaly_residual}
+SUFFIX=$([[ $SENSING == full ]] || echo "_$SENSING")
 OUT=outputs/campaign_family_plus$N
 FAMILY=ur5e,ur3e,ur10e,ur16e,ur20,ur30,fr3,iiwa14,gen3,xarm7
 for arm in ${ARMS//,/ }; do
-  UNSEEN_SESSIONS=$N PY=$PY bash studies/arms/loao_one_arm.sh $arm $FAMILY $OUT
+  UNSEEN_SESSIONS=$N SENSING=$SENSING NETWORK=$NET PY=$PY \
+    bash studies/arms/loao_one_arm.sh $arm $FAMILY $OUT
   V="$PY studies/arms/campaign.py --arms $arm --family $FAMILY --stages loao --out $OUT"
-  V="$V --seeds ${SEEDS:-42} --unseen-sessions $N"
+  V="$V --seeds ${SEEDS:-42} --unseen-sessions $N --sensing $SENSING"
   $V --variants gbdt --steps validate
-  $V --variants mlp,anomaly_residual --normalisation shift --steps validate
+  $V --variants mlp,$NET --normalisation shift --steps validate
   # validation picks the networks as trained over commissioned here: export them and count
   # their alarms over the arm's healthy hour too
-  $V --variants mlp,anomaly_residual --normalisation shift --steps export,alarms
+  $V --variants mlp,$NET --normalisation shift --steps export,alarms
 done
 S="$PY studies/arms/summarise.py --own outputs/campaign_seven --normalisation shift"
-S="$S --baseline-normalisation none --out $OUT"  # every seed run so far
-$S --against outputs/campaign_family_fixed > studies/arms/results/family_plus${N}_shift.md
-$S --as-trained > studies/arms/results/family_plus${N}_as_trained.md
-G="$PY studies/arms/class_gaps.py --arms fr3,xarm7,iiwa14,gen3 --out $OUT"  # every arm run so far
-$G > studies/arms/results/class_gaps_plus$N.md
-$G --as-trained > studies/arms/results/class_gaps_plus${N}_as_trained.md
+S="$S --baseline-normalisation none --out $OUT --sensing $SENSING"  # every seed run so far
+T=studies/arms/results/family_plus$N$SUFFIX
+$S --against outputs/campaign_family_fixed > ${T}_shift.md
+$S --as-trained > ${T}_as_trained.md
+if [[ $SENSING == full ]]; then
+  G="$PY studies/arms/class_gaps.py --arms fr3,xarm7,iiwa14,gen3 --out $OUT"  # every arm so far
+  $G > studies/arms/results/class_gaps_plus$N.md
+  $G --as-trained > studies/arms/results/class_gaps_plus${N}_as_trained.md
+else
+  $PY studies/arms/validation_sessions.py --out $OUT --sensing $SENSING \
+    --recipes uncommissioned,commissioned,commissioned_shift \
+    > studies/arms/results/validation_plus$N$SUFFIX.md
+fi
