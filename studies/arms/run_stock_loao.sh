@@ -5,9 +5,9 @@
 # the graph network this profile can have (no sensor nodes, so no coupling head and no
 # headline); commissioned as on the full profile (gbdt: none; the networks: shift), then every
 # recipe scored on the arm's validation sessions (programs no arm trains on) to pick one; the
-# networks as trained are exported and their alarms counted too. NETWORK=gat (or another graph
-# variant that reads joint nodes only) trains that network in stgnn_fixed's place; the finished
-# gbdt and mlp runs are skipped.
+# networks as trained are exported and their alarms counted too (validate_one_arm.sh).
+# NETWORK=gat (or another graph variant that reads joint nodes only) trains that network in
+# stgnn_fixed's place; the finished gbdt and mlp runs are skipped.
 # Reads the corpora run_seven.sh and run_validation.sh record and the own stock models
 # run_stock_own.sh trains; about 10 minutes an arm at one seed on 2 cores, 25 at two. The tables
 # go to studies/arms/results/TABLES_{shift,as_trained}.md and validation_TABLES.md (TABLES
@@ -23,14 +23,10 @@ OUT=outputs/campaign_family_fixed
 TABLES=${TABLES:-family_stock}
 NET=${NETWORK:-stgnn_fixed}
 for arm in ${ARMS//,/ }; do
-  SENSING=stock NETWORK=$NET SEEDS=$SEEDS PY=$PY \
-    bash studies/arms/loao_one_arm.sh "$arm" $FAMILY $OUT
-  V="$PY studies/arms/campaign.py --arms $arm --family $FAMILY --stages loao --seeds $SEEDS"
-  V="$V --sensing stock --out $OUT"
-  $V --variants gbdt,mlp,$NET --steps validate
-  $V --variants mlp,$NET --normalisation shift --steps validate
-  # validation may pick a network as trained: export those and count their alarms too
-  $V --variants mlp,$NET --normalisation shift --steps export,alarms
+  for step in loao_one_arm validate_one_arm; do
+    SENSING=stock NETWORK=$NET SEEDS=$SEEDS PY=$PY \
+      bash studies/arms/$step.sh "$arm" $FAMILY $OUT
+  done
 done
 S="$PY studies/arms/summarise.py --sensing stock --out $OUT --own outputs/campaign_seven"
 S="$S${TAG:+ --tag $TAG}"

@@ -22,15 +22,12 @@ SUFFIX=$([[ $SENSING == full ]] || echo "_$SENSING")
 OUT=outputs/campaign_family_plus$N
 FAMILY=ur5e,ur3e,ur10e,ur16e,ur20,ur30,fr3,iiwa14,gen3,xarm7
 for arm in ${ARMS//,/ }; do
-  UNSEEN_SESSIONS=$N SENSING=$SENSING NETWORK=$NET PY=$PY \
-    bash studies/arms/loao_one_arm.sh $arm $FAMILY $OUT
-  V="$PY studies/arms/campaign.py --arms $arm --family $FAMILY --stages loao --out $OUT"
-  V="$V --seeds ${SEEDS:-42} --unseen-sessions $N --sensing $SENSING"
-  $V --variants gbdt --steps validate
-  $V --variants mlp,$NET --normalisation shift --steps validate
-  # validation picks the networks as trained over commissioned here: export them and count
-  # their alarms over the arm's healthy hour too
-  $V --variants mlp,$NET --normalisation shift --steps export,alarms
+  # validation picks the networks as trained over commissioned here: validate_one_arm.sh
+  # exports them and counts their alarms over the arm's healthy hour too
+  for step in loao_one_arm validate_one_arm; do
+    UNSEEN_SESSIONS=$N SENSING=$SENSING NETWORK=$NET SEEDS=${SEEDS:-42} PY=$PY \
+      bash studies/arms/$step.sh $arm $FAMILY $OUT
+  done
 done
 S="$PY studies/arms/summarise.py --own outputs/campaign_seven --normalisation shift"
 S="$S --baseline-normalisation none --out $OUT --sensing $SENSING"  # every seed run so far
